@@ -22,6 +22,8 @@ pub(crate) struct SamplingView {
     pub fallback: bool,
     /// Block side S.
     pub scale: u32,
+    /// Pixels per axis per invocation of the `_unwarp` pass ([`unwarp_block`]).
+    pub unwarp_block: u32,
     /// The depth break as a WGSL f32 literal (a fraction of the nearer depth).
     pub depth_break: String,
     /// The light break as a WGSL f32 literal (a fraction of the brightest sample).
@@ -76,7 +78,7 @@ impl SamplingView {
             }
             Sampling::Lowres => "#import scatter::sampling::{lowres_grid, lowres_pixel, round_f16}",
             Sampling::Epipolar if unwarp => {
-                "#import scatter::sampling::{EpipolarLayout, epipolar_slices, epipolar_taps, lowres_blend}"
+                "#import scatter::sampling::{EpipolarLayout, epipolar_block_slices, epipolar_block_taps, epipolar_block_weights, lowres_blend}"
             }
             Sampling::Epipolar => {
                 "#import scatter::sampling::{EpipolarCamera, depth_close, epipolar_layout, round_f16, slice_direction, slice_sample_pixel, slice_span}"
@@ -88,6 +90,7 @@ impl SamplingView {
             unwarp,
             fallback,
             scale: knobs.scale,
+            unwarp_block: unwarp_block(knobs),
             depth_break: wgsl_f32(knobs.depth_break_fraction()),
             light_break: wgsl_f32(knobs.light_break_fraction()),
             slices: knobs.slices,
@@ -304,18 +307,27 @@ pub fn unwarp_pass(
     }
 }
 
+/// Pixels per axis of the blocks the epipolar unwarp gathers: the four samples around a
+/// block's centre, loaded once, stand for its pixels, each with its own weights (the centre's
+/// fractions moved by their gradients, clamped to the block's samples). Measured at 1280x720
+/// (minmax, 256 slices, a 1024x256 map; docs/roofline.md, "Stop 52"): the unwarp 22.0 ->
+/// 15.7 ms on a slow hour, 3 rounds, and on the 24 suite poses the same rel L1 to within 0.02
+/// points but where a block spans more than a slice (near an on-screen epipole), whose
+/// pixels are evaluated per pixel instead. One invocation per pixel was the unwarp before;
+/// a 2 x 2 quad gathering each pixel's own taps from shared loads of three slices (14 loads
+/// for four pixels instead of 32) saved nothing (13.3-14.2 ms against 13.9-14.3 even with
+/// the pixels whose taps it had not loaded left wrong, 19.4-22.9 ms with them loading their
+/// own: each pixel still computed its own slices, taps and selects; stop 45).
+pub const EPIPOLAR_UNWARP_BLOCK: u32 = 2;
+
 /// Pixels per axis one invocation of the `_unwarp` pass gathers: the lowres block side S (a
 /// block's pixels share their four samples, loaded once: `raymarch_unwarp` at lowres 4 took
 /// 6.4-7.8 ms at 1280x720 against 8.9-9.4 ms with one invocation per pixel; at lowres 2 no
-/// change, stop 45), or 1 for `epipolar`. A 2 x 2 quad gathering its pixels from shared
-/// loads of its three slices (14 loads for four pixels instead of 32) was measured and not
-/// kept: 13.3-14.2 ms against 13.9-14.3 even with the pixels whose taps it had not loaded
-/// left wrong, 19.4-22.9 ms with them loading their own (the unwarp is its per-pixel
-/// arithmetic and store more than its loads; docs/roofline.md, "Stop 45").
+/// change, stop 45), or [`EPIPOLAR_UNWARP_BLOCK`] for `epipolar`.
 pub fn unwarp_block(knobs: &SamplingKnobs) -> u32 {
     match knobs.sampling {
         Sampling::Lowres => knobs.scale,
-        _ => 1,
+        _ => EPIPOLAR_UNWARP_BLOCK,
     }
 }
 

@@ -111,7 +111,8 @@ const REFERENCE: &str = "raymarch-n64-i1";
 const EXPECTED_FAILURES: &[(&str, &str)] = &[
     (
         "random::partial_sum_tree-r4-ep128x128-s1::near_black_bar",
-        "3.5e-2 of the lit maximum (4.5e-2 before stop 50's rows on the slices) on \
+        "3.2e-2 of the lit maximum (3.5e-2 before stop 53's 2 x 2 block unwarp, 4.5e-2 before \
+         stop 50's rows on the slices) on \
          random::columns::0 (the sun 13.9 deg below the horizon, \
          looking towards it), minmax's ground tie (2.2e-2 per pixel): view rays ending on the \
          ground, whose own light ray is blocked at the ray's end. The sweep's samples lie on \

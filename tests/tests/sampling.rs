@@ -285,13 +285,14 @@ fn epipolar_stage_trial(
         ));
     }
     println!(
-        "sampling::{}::{}::{pose}: {} samples and pixels evaluated ({} for depth, {} for light) of {} pixels, {listed} listed for the fallback pass (mirror {expected}); {over} pixels over tolerance (layout ulps); max |diff| elsewhere {:.2e} of max",
+        "sampling::{}::{}::{pose}: {} samples and pixels evaluated ({} for depth, {} for light) of {} pixels, {listed} listed for the fallback pass (mirror {expected}, {} of them beyond their block's samples); {over} pixels over tolerance (layout ulps); max |diff| elsewhere {:.2e} of max",
         sampled.trial_name(),
         scene_label(base.light()),
         cpu.evaluated,
         cpu.depth_refined,
         cpu.light_refined,
         gpu.data.len(),
+        unwarped.dense,
         worst / max
     );
     Ok(())
@@ -430,7 +431,7 @@ fn stage_compare(
             tap_max = light[j].iter().copied().fold(tap_max, f32::max);
         }
         let d = depth.load(q[0], q[1]);
-        let blend = lowres_blend(t.w, depths, light, d, depth_break, light_break);
+        let blend = lowres_blend(t.w, t.w, depths, light, d, depth_break, light_break);
         // The light criterion compares a spread of the taps' light with a share of their
         // largest: where the two sides are within rounding of each other, either decision
         // is right ([`LIGHT_BREAK_EDGE`]).
@@ -438,9 +439,9 @@ fn stage_compare(
         // the neighbouring f16 value, which at a light break of 1 % is 5 % of the threshold.)
         let edge =
             (LIGHT_BREAK_EDGE * light_break).max(2.0 * f16_ulp(tap_max) / tap_max.max(1e-30));
-        let ambiguous = lowres_blend(t.w, depths, light, d, depth_break, light_break - edge)
+        let ambiguous = lowres_blend(t.w, t.w, depths, light, d, depth_break, light_break - edge)
             .is_some()
-            != lowres_blend(t.w, depths, light, d, depth_break, light_break + edge).is_some();
+            != lowres_blend(t.w, t.w, depths, light, d, depth_break, light_break + edge).is_some();
         if ambiguous {
             may_list += 1;
         } else if blend.is_none() {
@@ -449,6 +450,7 @@ fn stage_compare(
         if ambiguous {
             let own = at(q);
             let other = blend.or(lowres_blend(
+                t.w,
                 t.w,
                 depths,
                 light,

@@ -61,10 +61,17 @@ struct EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
     float dphi;
     uint wrap;
 };
-struct EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
+struct EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
     uvec2 slices;
     uvec2 k;
-    vec4 w;
+    float fs;
+    vec2 gs;
+    vec2 fk;
+    vec2 gk_lo;
+    vec2 gk_hi;
+    vec2 fs_range;
+    vec2 fk_min;
+    vec2 fk_max;
 };
 struct FallbackCount {
     uint listed;
@@ -91,6 +98,7 @@ const float DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX = 0.1;
 const uint SLICES = 512u;
 const uint SLICE_SAMPLES = 256u;
 const uint SLICE_LANES = 32u;
+const uint UNWARP_BLOCK = 2u;
 const uint STEP = 1u;
 const uint SLICE_RUNS = 256u;
 const float DEPTH_BREAK = 0.1;
@@ -122,17 +130,17 @@ vec3 shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_
 
 vec2 shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_1, vec3 ls) {
     float z_2 = max(ls.z, 1e-6);
-    float t_5 = v_1.proj.x;
-    return vec2((0.5 + ((0.5 * ls.x) / (z_2 * t_5))), (0.5 - ((0.5 * ls.y) / (z_2 * t_5))));
+    float t_3 = v_1.proj.x;
+    return vec2((0.5 + ((0.5 * ls.x) / (z_2 * t_3))), (0.5 - ((0.5 * ls.y) / (z_2 * t_3))));
 }
 
 float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_2, sampler2D sm, vec2 uv) {
     bool outside = ((((uv.x < 0.0) || (uv.x > 1.0)) || (uv.y < 0.0)) || (uv.y > 1.0));
     uint n_3 = v_2.size.x;
-    uint x_5 = min(uint((uv.x * float(n_3))), (n_3 - 1u));
+    uint x_7 = min(uint((uv.x * float(n_3))), (n_3 - 1u));
     uint y_1 = min(uint((uv.y * float(n_3))), (n_3 - 1u));
     int _e36_clamped_lod = clamp(0, 0, textureQueryLevels(sm) - 1);
-    vec4 _e36 = texelFetch(sm, clamp(ivec2(uvec2(x_5, y_1)), ivec2(0), textureSize(sm, _e36_clamped_lod) - ivec2(1)), _e36_clamped_lod);
+    vec4 _e36 = texelFetch(sm, clamp(ivec2(uvec2(x_7, y_1)), ivec2(0), textureSize(sm, _e36_clamped_lod) - ivec2(1)), _e36_clamped_lod);
     return (outside ? 2.0 : _e36.x);
 }
 
@@ -203,11 +211,11 @@ float phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float g, float cos_theta)
 }
 
 float transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t, float len) {
-    float x_6 = (sigma_t * len);
-    if ((x_6 < 0.0001)) {
-        return (len * (1.0 - (0.5 * x_6)));
+    float x_8 = (sigma_t * len);
+    if ((x_8 < 0.0001)) {
+        return (len * (1.0 - (0.5 * x_8)));
     }
-    return ((1.0 - exp(-(x_6))) / sigma_t);
+    return ((1.0 - exp(-(x_8))) / sigma_t);
 }
 
 float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t_1, float a, float b) {
@@ -216,13 +224,13 @@ float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_
 }
 
 float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float cos_angle, float cos_inner, float cos_outer) {
-    float x_7 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0.0, 1.0);
-    return (((cos_inner - cos_outer) <= 1e-6) ? ((cos_angle >= cos_outer) ? 1.0 : 0.0) : ((x_7 * x_7) * (3.0 - (2.0 * x_7))));
+    float x_9 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0.0, 1.0);
+    return (((cos_inner - cos_outer) <= 1e-6) ? ((cos_angle >= cos_outer) ? 1.0 : 0.0) : ((x_9 * x_9) * (3.0 - (2.0 * x_9))));
 }
 
 float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye, vec3 dir, float t, vec3 light_pos, vec3 light_dir, float cos_inner_1, float cos_outer_1, vec4 medium) {
-    vec3 x_8 = (eye + (dir * t));
-    vec3 to_x = (x_8 - light_pos);
+    vec3 x_10 = (eye + (dir * t));
+    vec3 to_x = (x_10 - light_pos);
     float d2_ = max(dot(to_x, to_x), 1e-12);
     float d_2 = sqrt(d2_);
     vec3 travel = (to_x / vec3(d_2));
@@ -323,8 +331,8 @@ float fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(vec2 o_1, vec2 u
 
 vec3 screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_3, vec2 p_2) {
     vec2 ndc = vec2((((2.0 * p_2.x) / float(f_3.sizes.x)) - 1.0), (1.0 - ((2.0 * p_2.y) / float(f_3.sizes.y))));
-    float t_6 = f_3.cam_forward.w;
-    return normalize(((f_3.cam_forward.xyz + (f_3.cam_right.xyz * ((ndc.x * t_6) * f_3.cam_right.w))) + (f_3.cam_up.xyz * (ndc.y * t_6))));
+    float t_4 = f_3.cam_forward.w;
+    return normalize(((f_3.cam_forward.xyz + (f_3.cam_right.xyz * ((ndc.x * t_4) * f_3.cam_right.w))) + (f_3.cam_up.xyz * (ndc.y * t_4))));
 }
 
 float fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_4, uint row_1) {
@@ -443,11 +451,11 @@ float ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil
     uint rows_1 = f_13.sizes.w;
     float phi_1 = atan(dot(dir_7, f_13.e2_.xyz), dot(dir_7, f_13.e1_.xyz));
     float z_5 = dot(dir_7, f_13.cam_forward.xyz);
-    float t_7 = f_13.cam_forward.w;
-    vec2 ndc_1 = vec2((dot(dir_7, f_13.cam_right.xyz) / ((z_5 * t_7) * f_13.cam_right.w)), (dot(dir_7, f_13.cam_up.xyz) / (z_5 * t_7)));
+    float t_5 = f_13.cam_forward.w;
+    vec2 ndc_1 = vec2((dot(dir_7, f_13.cam_right.xyz) / ((z_5 * t_5) * f_13.cam_right.w)), (dot(dir_7, f_13.cam_up.xyz) / (z_5 * t_5)));
     vec2 _e41 = screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13);
-    vec2 p_7 = (vec2(((ndc_1.x + 1.0) * 0.5), ((1.0 - ndc_1.y) * 0.5)) * _e41);
-    vec2 d_3 = (p_7 - f_13.fan_origin.xy);
+    vec2 p_5 = (vec2(((ndc_1.x + 1.0) * 0.5), ((1.0 - ndc_1.y) * 0.5)) * _e41);
+    vec2 d_3 = (p_5 - f_13.fan_origin.xy);
     vec2 ax_1 = f_13.fan_origin.zw;
     float fan = ((atan(((ax_1.x * d_3.y) - (ax_1.y * d_3.x)), ((ax_1.x * d_3.x) + (ax_1.y * d_3.y))) - f_13.fan_angles.x) / f_13.fan_angles.y);
     float yc = ((f_13.fan_angles.z > 0.5) ? fan : ((phi_1 - f_13.e1_.w) / f_13.e2_.w));
@@ -464,16 +472,16 @@ float ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mo
 }
 
 float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_15, float x_1, float delta, float theta_2, float s_2, bool spot_4) {
-    bool local_1 = false;
+    bool local_2 = false;
     if (spot_4) {
         float psi = (x_1 * delta);
         float den = sin((theta_2 + psi));
         if (!((den <= 1e-6))) {
-            local_1 = ((theta_2 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX);
+            local_2 = ((theta_2 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX);
         } else {
-            local_1 = true;
+            local_2 = true;
         }
-        bool _e16 = local_1;
+        bool _e16 = local_2;
         if (_e16) {
             return s_2;
         }
@@ -506,17 +514,17 @@ float lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_
 }
 
 bool depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(float a_6, float b_6, float depth_break) {
-    bool local_2 = false;
+    bool local_3 = false;
     if (!((a_6 == b_6))) {
-        local_2 = (abs((a_6 - b_6)) <= (depth_break * min(a_6, b_6)));
+        local_3 = (abs((a_6 - b_6)) <= (depth_break * min(a_6, b_6)));
     } else {
-        local_2 = true;
+        local_3 = true;
     }
-    bool _e13 = local_2;
+    bool _e13 = local_3;
     return _e13;
 }
 
-vec4 lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(vec4 w_1, vec4 depths_1, vec3 light_1[4], float d, float depth_break_1, float light_break) {
+vec4 lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(vec4 w_1, vec4 support, vec4 depths_1, vec3 light_1[4], float d, float depth_break_1, float light_break) {
     vec3 sum_2 = vec3(0.0, 0.0, 0.0);
     float total = 0.0;
     vec3 lo_1 = vec3(3.4e38, 3.4e38, 3.4e38);
@@ -524,13 +532,14 @@ vec4 lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(vec4 w_1, vec4 de
     uint taps = 0u;
     uint close = 0u;
     uint k_2 = 0u;
-    bool local_3 = false;
     bool local_4 = false;
+    bool local_5 = false;
+    bool local_6 = false;
     bool loop_init_3 = true;
     while(true) {
         if (!loop_init_3) {
-            uint _e63 = k_2;
-            k_2 = (_e63 + 1u);
+            uint _e72 = k_2;
+            k_2 = (_e72 + 1u);
         }
         loop_init_3 = false;
         uint _e6 = k_2;
@@ -539,61 +548,70 @@ vec4 lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(vec4 w_1, vec4 de
             break;
         }
         {
-            uint _e10 = taps;
-            uint _e12 = k_2;
-            taps = (_e10 + ((w_1[_e12] > 0.0) ? 1u : 0u));
-            uint _e20 = k_2;
-            if ((w_1[_e20] > 0.0)) {
-                uint _e25 = k_2;
-                bool _e29 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(depths_1[_e25], d, depth_break_1);
-                local_3 = _e29;
+            uint _e10 = k_2;
+            bool _e14 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(depths_1[_e10], d, depth_break_1);
+            uint _e16 = taps;
+            uint _e18 = k_2;
+            taps = (_e16 + ((support[_e18] > 0.0) ? 1u : 0u));
+            uint _e26 = k_2;
+            if ((support[_e26] > 0.0)) {
+                local_4 = _e14;
             } else {
-                local_3 = false;
+                local_4 = false;
             }
-            bool _e33 = local_3;
+            bool _e33 = local_4;
             if (_e33) {
                 uint _e35 = close;
                 close = (_e35 + 1u);
-                vec3 _e40 = sum_2;
+                vec3 _e40 = lo_1;
                 uint _e41 = k_2;
-                uint _e43 = k_2;
-                sum_2 = (_e40 + (w_1[_e41] * light_1[_e43]));
-                float _e48 = total;
-                uint _e49 = k_2;
-                total = (_e48 + w_1[_e49]);
-                vec3 _e53 = lo_1;
-                uint _e54 = k_2;
-                lo_1 = min(_e53, light_1[_e54]);
-                vec3 _e58 = hi_1;
-                uint _e59 = k_2;
-                hi_1 = max(_e58, light_1[_e59]);
+                lo_1 = min(_e40, light_1[_e41]);
+                vec3 _e45 = hi_1;
+                uint _e46 = k_2;
+                hi_1 = max(_e45, light_1[_e46]);
+            }
+            uint _e50 = k_2;
+            if ((w_1[_e50] > 0.0)) {
+                local_5 = _e14;
+            } else {
+                local_5 = false;
+            }
+            bool _e57 = local_5;
+            if (_e57) {
+                vec3 _e59 = sum_2;
+                uint _e60 = k_2;
+                uint _e62 = k_2;
+                sum_2 = (_e59 + (w_1[_e60] * light_1[_e62]));
+                float _e67 = total;
+                uint _e68 = k_2;
+                total = (_e67 + w_1[_e68]);
             }
         }
     }
-    float _e65 = total;
-    if (!((_e65 <= 0.0))) {
-        uint _e69 = close;
-        uint _e70 = taps;
-        local_4 = (_e69 < min(_e70, 2u));
+    float _e74 = total;
+    if (!((_e74 <= 0.0))) {
+        uint _e78 = close;
+        uint _e79 = taps;
+        local_6 = (_e78 < min(_e79, 2u));
     } else {
-        local_4 = true;
+        local_6 = true;
     }
-    bool _e77 = local_4;
-    if (_e77) {
+    bool _e86 = local_6;
+    if (_e86) {
         return vec4(0.0, 0.0, 0.0, 0.0);
     }
-    vec3 _e83 = hi_1;
-    vec3 _e84 = lo_1;
-    vec3 spread = (_e83 - _e84);
-    float _e93 = hi_1.x;
-    float _e95 = hi_1.y;
-    float _e97 = hi_1.z;
-    if ((max(spread.x, max(spread.y, spread.z)) > (light_break * max(_e93, max(_e95, _e97))))) {
+    vec3 _e92 = hi_1;
+    vec3 _e93 = lo_1;
+    vec3 spread = (_e92 - _e93);
+    float _e102 = hi_1.x;
+    float _e104 = hi_1.y;
+    float _e106 = hi_1.z;
+    if ((max(spread.x, max(spread.y, spread.z)) > (light_break * max(_e102, max(_e104, _e106))))) {
         return vec4(0.0, 0.0, 0.0, 0.0);
     }
-    vec3 _e107 = sum_2;
-    float _e108 = total;
-    vec3 c = (_e107 / vec3(_e108));
+    vec3 _e116 = sum_2;
+    float _e117 = total;
+    vec3 c = (_e116 / vec3(_e117));
     return vec4(c.x, c.y, c.z, 1.0);
 }
 
@@ -601,70 +619,86 @@ float epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(vec2 axis, vec
     return atan(((axis.x * d_1.y) - (axis.y * d_1.x)), ((axis.x * d_1.x) + (axis.y * d_1.y)));
 }
 
-EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_slicesX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX l_1, uvec2 p_4, uint slices) {
+EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_block_slicesX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX l_1, vec2 x_3, uint slices) {
     uint s_lo = 0u;
-    float fs = 0.0;
-    EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX t_3 = EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(uvec2(0u), uvec2(0u), vec4(0.0));
-    vec2 d_4 = ((vec2(p_4) + vec2(0.5, 0.5)) - l_1.origin);
-    float _e12 = epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_1.axis, d_4);
-    float f_21 = (((_e12 - l_1.phi_start) / l_1.dphi) - 0.5);
+    float base = 0.0;
+    EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX b_7 = EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(uvec2(0u), uvec2(0u), 0.0, vec2(0.0), vec2(0.0), vec2(0.0), vec2(0.0), vec2(0.0), vec2(0.0), vec2(0.0));
+    vec2 d_4 = (x_3 - l_1.origin);
+    float _e7 = epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_1.axis, d_4);
+    float f_21 = (((_e7 - l_1.phi_start) / l_1.dphi) - 0.5);
     if ((l_1.wrap != 0u)) {
         float fl = floor(f_21);
-        fs = (f_21 - fl);
+        base = fl;
         s_lo = (uint((int(fl) + int(slices))) % slices);
     } else {
         float fc = clamp(f_21, 0.0, float((slices - 1u)));
         s_lo = min(uint(fc), (slices - 2u));
-        uint _e41 = s_lo;
-        fs = (fc - float(_e41));
+        uint _e35 = s_lo;
+        base = float(_e35);
     }
-    uint _e46 = s_lo;
-    uint _e47 = s_lo;
-    t_3.slices = uvec2(_e46, ((_e47 + 1u) % slices));
-    float _e53 = fs;
-    float _e56 = fs;
-    t_3.w = vec4((1.0 - _e53), _e56, 0.0, 0.0);
-    EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e60 = t_3;
-    return _e60;
+    uint _e39 = s_lo;
+    uint _e40 = s_lo;
+    b_7.slices = uvec2(_e39, ((_e40 + 1u) % slices));
+    float _e46 = base;
+    b_7.fs = (f_21 - _e46);
+    float _e49 = base;
+    float _e54 = base;
+    b_7.fs_range = ((l_1.wrap != 0u) ? vec2(-3.4e38, 3.4e38) : vec2(-(_e49), (float((slices - 1u)) - _e54)));
+    vec2 gs = (vec2(-(d_4.y), d_4.x) / vec2((max(dot(d_4, d_4), 1e-20) * l_1.dphi)));
+    b_7.gs = uintBitsToFloat((floatBitsToUint(gs) & uvec2(4294963200u)));
+    EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e81 = b_7;
+    return _e81;
 }
 
-EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX l_2, uvec2 p_5, EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX pair, vec4 line_lo, vec4 line_hi, uint samples) {
-    EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX t_4 = EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(uvec2(0u), uvec2(0u), vec4(0.0));
-    uint j_2 = 0u;
-    vec2 d_5 = ((vec2(p_5) + vec2(0.5, 0.5)) - l_2.origin);
-    t_4 = pair;
-    vec2 ws = pair.w.xy;
-    bool loop_init_4 = true;
-    while(true) {
-        if (!loop_init_4) {
-            uint _e68 = j_2;
-            j_2 = (_e68 + 1u);
-        }
-        loop_init_4 = false;
-        uint _e15 = j_2;
-        if ((_e15 < 2u)) {
-        } else {
-            break;
-        }
-        {
-            uint _e18 = j_2;
-            vec4 line = ((_e18 == 1u) ? line_hi : line_lo);
-            float g_2 = ((dot(d_5, line.xy) - line.z) / max(line.w, 1e-20));
-            float gc = clamp(g_2, 0.0, float((samples - 1u)));
-            uint k_lo = min(uint(gc), (samples - 2u));
-            float fk = (gc - float(k_lo));
-            uint _e45 = j_2;
-            t_4.k[_e45] = k_lo;
-            uint _e49 = j_2;
-            uint _e52 = j_2;
-            t_4.w[(2u * _e49)] = (ws[_e52] * (1.0 - fk));
-            uint _e59 = j_2;
-            uint _e64 = j_2;
-            t_4.w[((2u * _e59) + 1u)] = (ws[_e64] * fk);
-        }
+EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_block_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX l_2, vec2 x_4, EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX block, vec4 line_lo, vec4 line_hi, uint samples) {
+    EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX b_8 = EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(uvec2(0u), uvec2(0u), 0.0, vec2(0.0), vec2(0.0), vec2(0.0), vec2(0.0), vec2(0.0), vec2(0.0), vec2(0.0));
+    vec2 d_5 = (x_4 - l_2.origin);
+    b_8 = block;
+    float s0_ = max(line_lo.w, 1e-20);
+    float s1_ = max(line_hi.w, 1e-20);
+    vec2 g_2 = vec2(((dot(d_5, line_lo.xy) - line_lo.z) / s0_), ((dot(d_5, line_hi.xy) - line_hi.z) / s1_));
+    vec2 gc = clamp(g_2, vec2(0.0, 0.0), vec2(float((samples - 1u))));
+    b_8.k = min(uvec2(gc), uvec2((samples - 2u)));
+    uvec2 _e42 = b_8.k;
+    b_8.fk = (g_2 - vec2(_e42));
+    uvec2 _e47 = b_8.k;
+    b_8.fk_min = -(vec2(_e47));
+    uvec2 _e56 = b_8.k;
+    b_8.fk_max = (vec2(float((samples - 1u))) - vec2(_e56));
+    b_8.gk_lo = (line_lo.xy / vec2(s0_));
+    b_8.gk_hi = (line_hi.xy / vec2(s1_));
+    EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e67 = b_8;
+    return _e67;
+}
+
+vec4 epipolar_block_weightsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX b_9, vec2 o_2) {
+    bool local_7 = false;
+    bool local_8 = false;
+    bool local_9 = false;
+    float own_s = clamp((b_9.fs + dot(b_9.gs, o_2)), b_9.fs_range.x, b_9.fs_range.y);
+    vec2 own_k = clamp((b_9.fk + vec2(dot(b_9.gk_lo, o_2), dot(b_9.gk_hi, o_2))), b_9.fk_min, b_9.fk_max);
+    if (!((own_s < -0.5))) {
+        local_7 = (own_s > 1.5);
+    } else {
+        local_7 = true;
     }
-    EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e70 = t_4;
-    return _e70;
+    bool _e29 = local_7;
+    if (!(_e29)) {
+        local_8 = any(lessThan(own_k, vec2(-0.5, -0.5)));
+    } else {
+        local_8 = true;
+    }
+    bool _e39 = local_8;
+    if (!(_e39)) {
+        local_9 = any(greaterThan(own_k, vec2(1.5, 1.5)));
+    } else {
+        local_9 = true;
+    }
+    bool beyond = local_9;
+    float fs = clamp(own_s, 0.0, 1.0);
+    vec2 fk = clamp(own_k, vec2(0.0, 0.0), vec2(1.0, 1.0));
+    vec4 w_4 = vec4(((1.0 - fs) * (1.0 - fk.x)), ((1.0 - fs) * fk.x), (fs * (1.0 - fk.y)), (fs * fk.y));
+    return (beyond ? vec4(0.0, 0.0, 0.0, 0.0) : w_4);
 }
 
 void fallback_list_reset() {
@@ -675,23 +709,23 @@ void fallback_list_reset() {
     return;
 }
 
-void unwarp_pixel(uvec2 q_1, vec4 w_2, vec4 depths_2, vec3 light_2[4]) {
+void unwarp_pixel(uvec2 q_1, vec4 w_2, vec4 support_1, vec4 depths_2, vec3 light_2[4]) {
     int _e3_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_2_cs) - 1);
     vec4 _e3 = texelFetch(_group_0_binding_2_cs, clamp(ivec2(q_1), ivec2(0), textureSize(_group_0_binding_2_cs, _e3_clamped_lod) - ivec2(1)), _e3_clamped_lod);
-    vec4 _e10 = lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(w_2, depths_2, light_2, _e3.x, DEPTH_BREAK, LIGHT_BREAK);
-    if ((_e10.w == 0.0)) {
-        uint _e17 = atomicAdd(_group_0_binding_11_cs.listed, 1u);
-        _group_0_binding_12_cs[_e17] = (q_1.x | (q_1.y << 16u));
-        if (((_e17 % 64u) == 0u)) {
-            uint g_3 = ((_e17 / 64u) + 1u);
-            uint _e37 = atomicMax(_group_0_binding_11_cs.groups_x, min(g_3, FALLBACK_ROW_GROUPS));
-            uint _e46 = atomicMax(_group_0_binding_11_cs.groups_y, (((g_3 + FALLBACK_ROW_GROUPS) - 1u) / FALLBACK_ROW_GROUPS));
+    vec4 _e11 = lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(w_2, support_1, depths_2, light_2, _e3.x, DEPTH_BREAK, LIGHT_BREAK);
+    if ((_e11.w == 0.0)) {
+        uint _e18 = atomicAdd(_group_0_binding_11_cs.listed, 1u);
+        _group_0_binding_12_cs[_e18] = (q_1.x | (q_1.y << 16u));
+        if (((_e18 % 64u) == 0u)) {
+            uint g_3 = ((_e18 / 64u) + 1u);
+            uint _e38 = atomicMax(_group_0_binding_11_cs.groups_x, min(g_3, FALLBACK_ROW_GROUPS));
+            uint _e47 = atomicMax(_group_0_binding_11_cs.groups_y, (((g_3 + FALLBACK_ROW_GROUPS) - 1u) / FALLBACK_ROW_GROUPS));
             return;
         } else {
             return;
         }
     } else {
-        imageStore(_group_0_binding_9_cs, ivec2(q_1), _e10);
+        imageStore(_group_0_binding_9_cs, ivec2(q_1), _e11);
         return;
     }
 }
@@ -717,57 +751,88 @@ void main() {
     vec4 depths = vec4(0.0, 0.0, 0.0, 0.0);
     vec3 light[4] = vec3[4](vec3(0.0), vec3(0.0), vec3(0.0), vec3(0.0));
     uint j = 0u;
+    uint i = 0u;
+    bool local_1 = false;
     uint _e6 = _group_0_binding_0_cs.sizes.x;
     uint _e10 = _group_0_binding_0_cs.sizes.y;
     uvec2 screen = uvec2(_e6, _e10);
-    uvec2 q_4 = id.xy;
-    if (!((q_4.x >= screen.x))) {
-        local = (q_4.y >= screen.y);
+    uvec2 q0_ = (id.xy * UNWARP_BLOCK);
+    if (!((q0_.x >= screen.x))) {
+        local = (q0_.y >= screen.y);
     } else {
         local = true;
     }
-    bool _e24 = local;
-    if (_e24) {
+    bool _e26 = local;
+    if (_e26) {
         return;
     }
-    int _e30_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_10_cs) - 1);
-    vec4 head = texelFetch(_group_0_binding_10_cs, clamp(ivec2(uvec2(0u, 512u)), ivec2(0), textureSize(_group_0_binding_10_cs, _e30_clamped_lod) - ivec2(1)), _e30_clamped_lod);
-    int _e36_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_10_cs) - 1);
-    vec4 angles = texelFetch(_group_0_binding_10_cs, clamp(ivec2(uvec2(1u, 512u)), ivec2(0), textureSize(_group_0_binding_10_cs, _e36_clamped_lod) - ivec2(1)), _e36_clamped_lod);
+    int _e32_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_10_cs) - 1);
+    vec4 head = texelFetch(_group_0_binding_10_cs, clamp(ivec2(uvec2(0u, 512u)), ivec2(0), textureSize(_group_0_binding_10_cs, _e32_clamped_lod) - ivec2(1)), _e32_clamped_lod);
+    int _e38_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_10_cs) - 1);
+    vec4 angles = texelFetch(_group_0_binding_10_cs, clamp(ivec2(uvec2(1u, 512u)), ivec2(0), textureSize(_group_0_binding_10_cs, _e38_clamped_lod) - ivec2(1)), _e38_clamped_lod);
     EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX lines = EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(head.xy, head.zw, angles.x, angles.y, uint(angles.z));
-    EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e45 = epipolar_slicesX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, q_4, SLICES);
-    int _e52_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_10_cs) - 1);
-    vec4 line_lo_1 = texelFetch(_group_0_binding_10_cs, clamp(ivec2(uvec2(SLICE_SAMPLES, _e45.slices.x)), ivec2(0), textureSize(_group_0_binding_10_cs, _e52_clamped_lod) - ivec2(1)), _e52_clamped_lod);
-    int _e59_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_10_cs) - 1);
-    vec4 line_hi_1 = texelFetch(_group_0_binding_10_cs, clamp(ivec2(uvec2(SLICE_SAMPLES, _e45.slices.y)), ivec2(0), textureSize(_group_0_binding_10_cs, _e59_clamped_lod) - ivec2(1)), _e59_clamped_lod);
-    EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e61 = epipolar_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, q_4, _e45, line_lo_1, line_hi_1, SLICE_SAMPLES);
-    bool loop_init_5 = true;
+    vec2 centre = (vec2(q0_) + vec2(1.0));
+    EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e51 = epipolar_block_slicesX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, centre, SLICES);
+    int _e58_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_10_cs) - 1);
+    vec4 line_lo_1 = texelFetch(_group_0_binding_10_cs, clamp(ivec2(uvec2(SLICE_SAMPLES, _e51.slices.x)), ivec2(0), textureSize(_group_0_binding_10_cs, _e58_clamped_lod) - ivec2(1)), _e58_clamped_lod);
+    int _e65_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_10_cs) - 1);
+    vec4 line_hi_1 = texelFetch(_group_0_binding_10_cs, clamp(ivec2(uvec2(SLICE_SAMPLES, _e51.slices.y)), ivec2(0), textureSize(_group_0_binding_10_cs, _e65_clamped_lod) - ivec2(1)), _e65_clamped_lod);
+    EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e67 = epipolar_block_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, centre, _e51, line_lo_1, line_hi_1, SLICE_SAMPLES);
+    bool loop_init_4 = true;
     while(true) {
-        if (!loop_init_5) {
-            uint _e93 = j;
-            j = (_e93 + 1u);
+        if (!loop_init_4) {
+            uint _e99 = j;
+            j = (_e99 + 1u);
         }
-        loop_init_5 = false;
-        uint _e63 = j;
-        if ((_e63 < 4u)) {
+        loop_init_4 = false;
+        uint _e69 = j;
+        if ((_e69 < 4u)) {
         } else {
             break;
         }
         {
-            uint _e67 = j;
-            uint _e71 = j;
-            uint _e76 = j;
-            int _e83_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_10_cs) - 1);
-            vec4 v_11 = texelFetch(_group_0_binding_10_cs, clamp(ivec2(uvec2((_e61.k[(_e67 / 2u)] + (_e71 % 2u)), _e61.slices[(_e76 / 2u)])), ivec2(0), textureSize(_group_0_binding_10_cs, _e83_clamped_lod) - ivec2(1)), _e83_clamped_lod);
-            uint _e85 = j;
-            depths[_e85] = v_11.w;
-            uint _e89 = j;
-            light[_e89] = v_11.xyz;
+            uint _e73 = j;
+            uint _e77 = j;
+            uint _e82 = j;
+            int _e89_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_10_cs) - 1);
+            vec4 v_11 = texelFetch(_group_0_binding_10_cs, clamp(ivec2(uvec2((_e67.k[(_e73 / 2u)] + (_e77 % 2u)), _e67.slices[(_e82 / 2u)])), ivec2(0), textureSize(_group_0_binding_10_cs, _e89_clamped_lod) - ivec2(1)), _e89_clamped_lod);
+            uint _e91 = j;
+            depths[_e91] = v_11.w;
+            uint _e95 = j;
+            light[_e95] = v_11.xyz;
         }
     }
-    vec4 _e96 = depths;
-    vec3 _e97[4] = light;
-    unwarp_pixel(q_4, _e61.w, _e96, _e97);
+    vec4 _e104 = epipolar_block_weightsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e67, vec2(0.0, 0.0));
+    bool loop_init_5 = true;
+    while(true) {
+        if (!loop_init_5) {
+            uint _e137 = i;
+            i = (_e137 + 1u);
+        }
+        loop_init_5 = false;
+        uint _e106 = i;
+        if ((_e106 < 4u)) {
+        } else {
+            break;
+        }
+        {
+            uint _e109 = i;
+            uint _e112 = i;
+            uvec2 q_4 = (q0_ + uvec2((_e109 % UNWARP_BLOCK), (_e112 / UNWARP_BLOCK)));
+            if ((q_4.x < screen.x)) {
+                local_1 = (q_4.y < screen.y);
+            } else {
+                local_1 = false;
+            }
+            bool _e126 = local_1;
+            if (_e126) {
+                vec4 _e133 = epipolar_block_weightsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e67, ((vec2(q_4) + vec2(0.5, 0.5)) - centre));
+                vec4 _e134 = depths;
+                vec3 _e135[4] = light;
+                unwarp_pixel(q_4, _e133, _e104, _e134, _e135);
+            }
+        }
+    }
     return;
 }
 

@@ -62,10 +62,18 @@ struct EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
     int _end_pad_0;
 };
 
-struct EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
+struct EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
     uint2 slices;
     uint2 k;
-    float4 w;
+    float fs;
+    int _pad3_0;
+    float2 gs;
+    float2 fk;
+    float2 gk_lo;
+    float2 gk_hi;
+    float2 fs_range;
+    float2 fk_min;
+    float2 fk_max;
 };
 
 struct FallbackCount {
@@ -100,6 +108,7 @@ static const float DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX = 0
 static const uint SLICES = 512u;
 static const uint SLICE_SAMPLES = 256u;
 static const uint SLICE_LANES = 32u;
+static const uint UNWARP_BLOCK = 2u;
 static const uint STEP = 1u;
 static const uint SLICE_RUNS = 256u;
 static const float DEPTH_BREAK = 0.1;
@@ -127,8 +136,8 @@ float3 shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapView
 float2 shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_1, float3 ls)
 {
     float z_2 = max(ls.z, 1e-6);
-    float t_5 = v_1.proj.x;
-    return float2((0.5 + ((0.5 * ls.x) / (z_2 * t_5))), (0.5 - ((0.5 * ls.y) / (z_2 * t_5))));
+    float t_3 = v_1.proj.x;
+    return float2((0.5 + ((0.5 * ls.x) / (z_2 * t_3))), (0.5 - ((0.5 * ls.y) / (z_2 * t_3))));
 }
 
 uint naga_f2u32(float value) {
@@ -139,9 +148,9 @@ float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_
 {
     bool outside = ((((uv.x < 0.0) | (uv.x > 1.0)) | (uv.y < 0.0)) | (uv.y > 1.0));
     uint n_3 = v_2.size.x;
-    uint x_5 = min(naga_f2u32((uv.x * float(n_3))), (n_3 - 1u));
+    uint x_7 = min(naga_f2u32((uv.x * float(n_3))), (n_3 - 1u));
     uint y_1 = min(naga_f2u32((uv.y * float(n_3))), (n_3 - 1u));
-    float4 _e36 = sm.Load(int3(uint2(x_5, y_1), int(0)));
+    float4 _e36 = sm.Load(int3(uint2(x_7, y_1), int(0)));
     return (outside ? 2.0 : _e36.x);
 }
 
@@ -220,11 +229,11 @@ float phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float g, float cos_theta)
 
 float transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t, float len)
 {
-    float x_6 = (sigma_t * len);
-    if ((x_6 < 0.0001)) {
-        return (len * (1.0 - (0.5 * x_6)));
+    float x_8 = (sigma_t * len);
+    if ((x_8 < 0.0001)) {
+        return (len * (1.0 - (0.5 * x_8)));
     }
-    return ((1.0 - exp(-(x_6))) / sigma_t);
+    return ((1.0 - exp(-(x_8))) / sigma_t);
 }
 
 float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t_1, float a, float b)
@@ -235,14 +244,14 @@ float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_
 
 float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float cos_angle, float cos_inner, float cos_outer)
 {
-    float x_7 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0.0, 1.0);
-    return (((cos_inner - cos_outer) <= 1e-6) ? ((cos_angle >= cos_outer) ? 1.0 : 0.0) : ((x_7 * x_7) * (3.0 - (2.0 * x_7))));
+    float x_9 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0.0, 1.0);
+    return (((cos_inner - cos_outer) <= 1e-6) ? ((cos_angle >= cos_outer) ? 1.0 : 0.0) : ((x_9 * x_9) * (3.0 - (2.0 * x_9))));
 }
 
 float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye, float3 dir, float t, float3 light_pos, float3 light_dir, float cos_inner_1, float cos_outer_1, float4 medium)
 {
-    float3 x_8 = (eye + (dir * t));
-    float3 to_x = (x_8 - light_pos);
+    float3 x_10 = (eye + (dir * t));
+    float3 to_x = (x_10 - light_pos);
     float d2_ = max(dot(to_x, to_x), 1e-12);
     float d_2 = sqrt(d2_);
     float3 travel = (to_x / (d_2).xxx);
@@ -379,8 +388,8 @@ float fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(float2 o_1, floa
 float3 screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_3, float2 p_2)
 {
     float2 ndc = float2((((2.0 * p_2.x) / float(f_3.sizes.x)) - 1.0), (1.0 - ((2.0 * p_2.y) / float(f_3.sizes.y))));
-    float t_6 = f_3.cam_forward.w;
-    return normalize(((f_3.cam_forward.xyz + (f_3.cam_right.xyz * ((ndc.x * t_6) * f_3.cam_right.w))) + (f_3.cam_up.xyz * (ndc.y * t_6))));
+    float t_4 = f_3.cam_forward.w;
+    return normalize(((f_3.cam_forward.xyz + (f_3.cam_right.xyz * ((ndc.x * t_4) * f_3.cam_right.w))) + (f_3.cam_up.xyz * (ndc.y * t_4))));
 }
 
 float fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_4, uint row_1)
@@ -536,11 +545,11 @@ float ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil
     uint rows_1 = f_13.sizes.w;
     float phi_1 = atan2(dot(dir_7, f_13.e2_.xyz), dot(dir_7, f_13.e1_.xyz));
     float z_5 = dot(dir_7, f_13.cam_forward.xyz);
-    float t_7 = f_13.cam_forward.w;
-    float2 ndc_1 = float2((dot(dir_7, f_13.cam_right.xyz) / ((z_5 * t_7) * f_13.cam_right.w)), (dot(dir_7, f_13.cam_up.xyz) / (z_5 * t_7)));
+    float t_5 = f_13.cam_forward.w;
+    float2 ndc_1 = float2((dot(dir_7, f_13.cam_right.xyz) / ((z_5 * t_5) * f_13.cam_right.w)), (dot(dir_7, f_13.cam_up.xyz) / (z_5 * t_5)));
     const float2 _e41 = screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13);
-    float2 p_7 = (float2(((ndc_1.x + 1.0) * 0.5), ((1.0 - ndc_1.y) * 0.5)) * _e41);
-    float2 d_3 = (p_7 - f_13.fan_origin.xy);
+    float2 p_5 = (float2(((ndc_1.x + 1.0) * 0.5), ((1.0 - ndc_1.y) * 0.5)) * _e41);
+    float2 d_3 = (p_5 - f_13.fan_origin.xy);
     float2 ax_1 = f_13.fan_origin.zw;
     float fan = ((atan2(((ax_1.x * d_3.y) - (ax_1.y * d_3.x)), ((ax_1.x * d_3.x) + (ax_1.y * d_3.y))) - f_13.fan_angles.x) / f_13.fan_angles.y);
     float yc = ((f_13.fan_angles.z > 0.5) ? fan : ((phi_1 - f_13.e1_.w) / f_13.e2_.w));
@@ -559,17 +568,17 @@ float ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mo
 
 float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_15, float x_1, float delta, float theta_2, float s_2, bool spot_4)
 {
-    bool local_1 = (bool)0;
+    bool local_2 = (bool)0;
 
     if (spot_4) {
         float psi = (x_1 * delta);
         float den = sin((theta_2 + psi));
         if (!((den <= 1e-6))) {
-            local_1 = ((theta_2 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX);
+            local_2 = ((theta_2 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX);
         } else {
-            local_1 = true;
+            local_2 = true;
         }
-        bool _e16 = local_1;
+        bool _e16 = local_2;
         if (_e16) {
             return s_2;
         }
@@ -610,18 +619,18 @@ float lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_mod_
 
 bool depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(float a_6, float b_6, float depth_break)
 {
-    bool local_2 = (bool)0;
+    bool local_3 = (bool)0;
 
     if (!((a_6 == b_6))) {
-        local_2 = (abs((a_6 - b_6)) <= (depth_break * min(a_6, b_6)));
+        local_3 = (abs((a_6 - b_6)) <= (depth_break * min(a_6, b_6)));
     } else {
-        local_2 = true;
+        local_3 = true;
     }
-    bool _e13 = local_2;
+    bool _e13 = local_3;
     return _e13;
 }
 
-float4 lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(float4 w_1, float4 depths_1, float3 light_1[4], float d, float depth_break_1, float light_break)
+float4 lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(float4 w_1, float4 support, float4 depths_1, float3 light_1[4], float d, float depth_break_1, float light_break)
 {
     float3 sum_2 = float3(0.0, 0.0, 0.0);
     float total = 0.0;
@@ -630,8 +639,9 @@ float4 lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(float4 w_1, flo
     uint taps = 0u;
     uint close = 0u;
     uint k_2 = 0u;
-    bool local_3 = (bool)0;
     bool local_4 = (bool)0;
+    bool local_5 = (bool)0;
+    bool local_6 = (bool)0;
 
     uint2 loop_bound_3 = uint2(4294967295u, 4294967295u);
     bool loop_init_3 = true;
@@ -639,8 +649,8 @@ float4 lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(float4 w_1, flo
         if (all(loop_bound_3 == uint2(0u, 0u))) { break; }
         loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
         if (!loop_init_3) {
-            uint _e63 = k_2;
-            k_2 = (_e63 + 1u);
+            uint _e72 = k_2;
+            k_2 = (_e72 + 1u);
         }
         loop_init_3 = false;
         uint _e6 = k_2;
@@ -649,61 +659,70 @@ float4 lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(float4 w_1, flo
             break;
         }
         {
-            uint _e10 = taps;
-            uint _e12 = k_2;
-            taps = (_e10 + ((w_1[min(uint(_e12), 3u)] > 0.0) ? 1u : 0u));
-            uint _e20 = k_2;
-            if ((w_1[min(uint(_e20), 3u)] > 0.0)) {
-                uint _e25 = k_2;
-                const bool _e29 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(depths_1[min(uint(_e25), 3u)], d, depth_break_1);
-                local_3 = _e29;
+            uint _e10 = k_2;
+            const bool _e14 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(depths_1[min(uint(_e10), 3u)], d, depth_break_1);
+            uint _e16 = taps;
+            uint _e18 = k_2;
+            taps = (_e16 + ((support[min(uint(_e18), 3u)] > 0.0) ? 1u : 0u));
+            uint _e26 = k_2;
+            if ((support[min(uint(_e26), 3u)] > 0.0)) {
+                local_4 = _e14;
             } else {
-                local_3 = false;
+                local_4 = false;
             }
-            bool _e33 = local_3;
+            bool _e33 = local_4;
             if (_e33) {
                 uint _e35 = close;
                 close = (_e35 + 1u);
-                float3 _e40 = sum_2;
+                float3 _e40 = lo_1;
                 uint _e41 = k_2;
-                uint _e43 = k_2;
-                sum_2 = (_e40 + (w_1[min(uint(_e41), 3u)] * light_1[min(uint(_e43), 3u)]));
-                float _e48 = total;
-                uint _e49 = k_2;
-                total = (_e48 + w_1[min(uint(_e49), 3u)]);
-                float3 _e53 = lo_1;
-                uint _e54 = k_2;
-                lo_1 = min(_e53, light_1[min(uint(_e54), 3u)]);
-                float3 _e58 = hi_1;
-                uint _e59 = k_2;
-                hi_1 = max(_e58, light_1[min(uint(_e59), 3u)]);
+                lo_1 = min(_e40, light_1[min(uint(_e41), 3u)]);
+                float3 _e45 = hi_1;
+                uint _e46 = k_2;
+                hi_1 = max(_e45, light_1[min(uint(_e46), 3u)]);
+            }
+            uint _e50 = k_2;
+            if ((w_1[min(uint(_e50), 3u)] > 0.0)) {
+                local_5 = _e14;
+            } else {
+                local_5 = false;
+            }
+            bool _e57 = local_5;
+            if (_e57) {
+                float3 _e59 = sum_2;
+                uint _e60 = k_2;
+                uint _e62 = k_2;
+                sum_2 = (_e59 + (w_1[min(uint(_e60), 3u)] * light_1[min(uint(_e62), 3u)]));
+                float _e67 = total;
+                uint _e68 = k_2;
+                total = (_e67 + w_1[min(uint(_e68), 3u)]);
             }
         }
     }
-    float _e65 = total;
-    if (!((_e65 <= 0.0))) {
-        uint _e69 = close;
-        uint _e70 = taps;
-        local_4 = (_e69 < min(_e70, 2u));
+    float _e74 = total;
+    if (!((_e74 <= 0.0))) {
+        uint _e78 = close;
+        uint _e79 = taps;
+        local_6 = (_e78 < min(_e79, 2u));
     } else {
-        local_4 = true;
+        local_6 = true;
     }
-    bool _e77 = local_4;
-    if (_e77) {
+    bool _e86 = local_6;
+    if (_e86) {
         return float4(0.0, 0.0, 0.0, 0.0);
     }
-    float3 _e83 = hi_1;
-    float3 _e84 = lo_1;
-    float3 spread = (_e83 - _e84);
-    float _e93 = hi_1.x;
-    float _e95 = hi_1.y;
-    float _e97 = hi_1.z;
-    if ((max(spread.x, max(spread.y, spread.z)) > (light_break * max(_e93, max(_e95, _e97))))) {
+    float3 _e92 = hi_1;
+    float3 _e93 = lo_1;
+    float3 spread = (_e92 - _e93);
+    float _e102 = hi_1.x;
+    float _e104 = hi_1.y;
+    float _e106 = hi_1.z;
+    if ((max(spread.x, max(spread.y, spread.z)) > (light_break * max(_e102, max(_e104, _e106))))) {
         return float4(0.0, 0.0, 0.0, 0.0);
     }
-    float3 _e107 = sum_2;
-    float _e108 = total;
-    float3 c = (_e107 / (_e108).xxx);
+    float3 _e116 = sum_2;
+    float _e117 = total;
+    float3 c = (_e116 / (_e117).xxx);
     return float4(c.x, c.y, c.z, 1.0);
 }
 
@@ -716,79 +735,98 @@ uint naga_mod(uint lhs, uint rhs) {
     return lhs % (rhs == 0u ? 1u : rhs);
 }
 
-EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_slicesX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX l_1, uint2 p_4, uint slices)
+EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_block_slicesX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX l_1, float2 x_3, uint slices)
 {
     uint s_lo = 0u;
-    float fs = 0.0;
-    EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX t_3 = (EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX)0;
+    float base = 0.0;
+    EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX b_7 = (EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX)0;
 
-    float2 d_4 = ((float2(p_4) + float2(0.5, 0.5)) - l_1.origin);
-    const float _e12 = epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_1.axis, d_4);
-    float f_21 = (((_e12 - l_1.phi_start) / l_1.dphi) - 0.5);
+    float2 d_4 = (x_3 - l_1.origin);
+    const float _e7 = epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_1.axis, d_4);
+    float f_21 = (((_e7 - l_1.phi_start) / l_1.dphi) - 0.5);
     if ((l_1.wrap != 0u)) {
         float fl = floor(f_21);
-        fs = (f_21 - fl);
+        base = fl;
         s_lo = naga_mod(uint(asint(asuint(naga_f2i32(fl)) + asuint(int(slices)))), slices);
     } else {
         float fc = clamp(f_21, 0.0, float((slices - 1u)));
         s_lo = min(naga_f2u32(fc), (slices - 2u));
-        uint _e41 = s_lo;
-        fs = (fc - float(_e41));
+        uint _e35 = s_lo;
+        base = float(_e35);
     }
-    uint _e46 = s_lo;
-    uint _e47 = s_lo;
-    t_3.slices = uint2(_e46, naga_mod((_e47 + 1u), slices));
-    float _e53 = fs;
-    float _e56 = fs;
-    t_3.w = float4((1.0 - _e53), _e56, 0.0, 0.0);
-    EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e60 = t_3;
-    const EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolartapsx_naga_oil_mod_xonrwc5dumvzduottmfwxa3djnztqx = _e60;
-    return epipolartapsx_naga_oil_mod_xonrwc5dumvzduottmfwxa3djnztqx;
+    uint _e39 = s_lo;
+    uint _e40 = s_lo;
+    b_7.slices = uint2(_e39, naga_mod((_e40 + 1u), slices));
+    float _e46 = base;
+    b_7.fs = (f_21 - _e46);
+    float _e49 = base;
+    float _e54 = base;
+    b_7.fs_range = ((l_1.wrap != 0u) ? float2(-3.4e38, 3.4e38) : float2(-(_e49), (float((slices - 1u)) - _e54)));
+    float2 gs = (float2(-(d_4.y), d_4.x) / ((max(dot(d_4, d_4), 1e-20) * l_1.dphi)).xx);
+    b_7.gs = asfloat((asuint(gs) & (4294963200u).xx));
+    EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e81 = b_7;
+    const EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolarblockx_naga_oil_mod_xonrwc5dumvzduottmfwxa3djnztqx = _e81;
+    return epipolarblockx_naga_oil_mod_xonrwc5dumvzduottmfwxa3djnztqx;
 }
 
-EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX l_2, uint2 p_5, EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX pair, float4 line_lo, float4 line_hi, uint samples)
-{
-    EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX t_4 = (EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX)0;
-    uint j_2 = 0u;
+uint2 naga_f2u32(float2 value) {
+    return uint2(clamp(value, 0.0, 4294967000.0));
+}
 
-    float2 d_5 = ((float2(p_5) + float2(0.5, 0.5)) - l_2.origin);
-    t_4 = pair;
-    float2 ws = pair.w.xy;
-    uint2 loop_bound_4 = uint2(4294967295u, 4294967295u);
-    bool loop_init_4 = true;
-    while(true) {
-        if (all(loop_bound_4 == uint2(0u, 0u))) { break; }
-        loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
-        if (!loop_init_4) {
-            uint _e68 = j_2;
-            j_2 = (_e68 + 1u);
-        }
-        loop_init_4 = false;
-        uint _e15 = j_2;
-        if ((_e15 < 2u)) {
-        } else {
-            break;
-        }
-        {
-            uint _e18 = j_2;
-            float4 line_ = ((_e18 == 1u) ? line_hi : line_lo);
-            float g_2 = ((dot(d_5, line_.xy) - line_.z) / max(line_.w, 1e-20));
-            float gc = clamp(g_2, 0.0, float((samples - 1u)));
-            uint k_lo = min(naga_f2u32(gc), (samples - 2u));
-            float fk = (gc - float(k_lo));
-            uint _e45 = j_2;
-            t_4.k[min(uint(_e45), 1u)] = k_lo;
-            uint _e49 = j_2;
-            uint _e52 = j_2;
-            t_4.w[min(uint((2u * _e49)), 3u)] = (ws[min(uint(_e52), 1u)] * (1.0 - fk));
-            uint _e59 = j_2;
-            uint _e64 = j_2;
-            t_4.w[min(uint(((2u * _e59) + 1u)), 3u)] = (ws[min(uint(_e64), 1u)] * fk);
-        }
+EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_block_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX l_2, float2 x_4, EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX block, float4 line_lo, float4 line_hi, uint samples)
+{
+    EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX b_8 = (EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX)0;
+
+    float2 d_5 = (x_4 - l_2.origin);
+    b_8 = block;
+    float s0_ = max(line_lo.w, 1e-20);
+    float s1_ = max(line_hi.w, 1e-20);
+    float2 g_2 = float2(((dot(d_5, line_lo.xy) - line_lo.z) / s0_), ((dot(d_5, line_hi.xy) - line_hi.z) / s1_));
+    float2 gc = clamp(g_2, float2(0.0, 0.0), (float((samples - 1u))).xx);
+    b_8.k = min(naga_f2u32(gc), ((samples - 2u)).xx);
+    uint2 _e42 = b_8.k;
+    b_8.fk = (g_2 - float2(_e42));
+    uint2 _e47 = b_8.k;
+    b_8.fk_min = -(float2(_e47));
+    uint2 _e56 = b_8.k;
+    b_8.fk_max = ((float((samples - 1u))).xx - float2(_e56));
+    b_8.gk_lo = (line_lo.xy / (s0_).xx);
+    b_8.gk_hi = (line_hi.xy / (s1_).xx);
+    EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e67 = b_8;
+    const EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolarblockx_naga_oil_mod_xonrwc5dumvzduottmfwxa3djnztqx_1 = _e67;
+    return epipolarblockx_naga_oil_mod_xonrwc5dumvzduottmfwxa3djnztqx_1;
+}
+
+float4 epipolar_block_weightsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX b_9, float2 o_2)
+{
+    bool local_7 = (bool)0;
+    bool local_8 = (bool)0;
+    bool local_9 = (bool)0;
+
+    float own_s = clamp((b_9.fs + dot(b_9.gs, o_2)), b_9.fs_range.x, b_9.fs_range.y);
+    float2 own_k = clamp((b_9.fk + float2(dot(b_9.gk_lo, o_2), dot(b_9.gk_hi, o_2))), b_9.fk_min, b_9.fk_max);
+    if (!((own_s < -0.5))) {
+        local_7 = (own_s > 1.5);
+    } else {
+        local_7 = true;
     }
-    EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e70 = t_4;
-    const EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolartapsx_naga_oil_mod_xonrwc5dumvzduottmfwxa3djnztqx_1 = _e70;
-    return epipolartapsx_naga_oil_mod_xonrwc5dumvzduottmfwxa3djnztqx_1;
+    bool _e29 = local_7;
+    if (!(_e29)) {
+        local_8 = any((own_k < float2(-0.5, -0.5)));
+    } else {
+        local_8 = true;
+    }
+    bool _e39 = local_8;
+    if (!(_e39)) {
+        local_9 = any((own_k > float2(1.5, 1.5)));
+    } else {
+        local_9 = true;
+    }
+    bool beyond = local_9;
+    float fs = clamp(own_s, 0.0, 1.0);
+    float2 fk = clamp(own_k, float2(0.0, 0.0), float2(1.0, 1.0));
+    float4 w_4 = float4(((1.0 - fs) * (1.0 - fk.x)), ((1.0 - fs) * fk.x), (fs * (1.0 - fk.y)), (fs * fk.y));
+    return (beyond ? float4(0.0, 0.0, 0.0, 0.0) : w_4);
 }
 
 void fallback_list_reset()
@@ -800,23 +838,23 @@ void fallback_list_reset()
     return;
 }
 
-void unwarp_pixel(uint2 q_1, float4 w_2, float4 depths_2, float3 light_2[4])
+void unwarp_pixel(uint2 q_1, float4 w_2, float4 support_1, float4 depths_2, float3 light_2[4])
 {
     float4 _e3 = depth.Load(int3(q_1, int(0)));
-    const float4 _e10 = lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(w_2, depths_2, light_2, _e3.x, DEPTH_BREAK, LIGHT_BREAK);
-    if ((_e10.w == 0.0)) {
-        uint _e17; fallback_count.InterlockedAdd(0, 1u, _e17);
-        fallback_pixels.Store(_e17*4, asuint((q_1.x | (q_1.y << 16u))));
-        if ((naga_mod(_e17, 64u) == 0u)) {
-            uint g_3 = (naga_div(_e17, 64u) + 1u);
-            uint _e37; fallback_count.InterlockedMax(4, min(g_3, FALLBACK_ROW_GROUPS), _e37);
-            uint _e46; fallback_count.InterlockedMax(8, naga_div(((g_3 + FALLBACK_ROW_GROUPS) - 1u), FALLBACK_ROW_GROUPS), _e46);
+    const float4 _e11 = lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(w_2, support_1, depths_2, light_2, _e3.x, DEPTH_BREAK, LIGHT_BREAK);
+    if ((_e11.w == 0.0)) {
+        uint _e18; fallback_count.InterlockedAdd(0, 1u, _e18);
+        fallback_pixels.Store(_e18*4, asuint((q_1.x | (q_1.y << 16u))));
+        if ((naga_mod(_e18, 64u) == 0u)) {
+            uint g_3 = (naga_div(_e18, 64u) + 1u);
+            uint _e38; fallback_count.InterlockedMax(4, min(g_3, FALLBACK_ROW_GROUPS), _e38);
+            uint _e47; fallback_count.InterlockedMax(8, naga_div(((g_3 + FALLBACK_ROW_GROUPS) - 1u), FALLBACK_ROW_GROUPS), _e47);
             return;
         } else {
             return;
         }
     } else {
-        output[q_1] = _e10;
+        output[q_1] = _e11;
         return;
     }
 }
@@ -855,55 +893,89 @@ void pst_sweep_unwarp(uint3 id : SV_DispatchThreadID)
     float4 depths = float4(0.0, 0.0, 0.0, 0.0);
     float3 light[4] = (float3[4])0;
     uint j = 0u;
+    uint i = 0u;
+    bool local_1 = (bool)0;
 
     uint _e6 = frame.sizes.x;
     uint _e10 = frame.sizes.y;
     uint2 screen = uint2(_e6, _e10);
-    uint2 q_4 = id.xy;
-    if (!((q_4.x >= screen.x))) {
-        local = (q_4.y >= screen.y);
+    uint2 q0_ = (id.xy * UNWARP_BLOCK);
+    if (!((q0_.x >= screen.x))) {
+        local = (q0_.y >= screen.y);
     } else {
         local = true;
     }
-    bool _e24 = local;
-    if (_e24) {
+    bool _e26 = local;
+    if (_e26) {
         return;
     }
     float4 head = epipolar_samples.Load(int3(uint2(0u, 512u), int(0)));
     float4 angles = epipolar_samples.Load(int3(uint2(1u, 512u), int(0)));
     EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX lines = ConstructEpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(head.xy, head.zw, angles.x, angles.y, naga_f2u32(angles.z));
-    const EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e45 = epipolar_slicesX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, q_4, SLICES);
-    float4 line_lo_1 = epipolar_samples.Load(int3(uint2(SLICE_SAMPLES, _e45.slices.x), int(0)));
-    float4 line_hi_1 = epipolar_samples.Load(int3(uint2(SLICE_SAMPLES, _e45.slices.y), int(0)));
-    const EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e61 = epipolar_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, q_4, _e45, line_lo_1, line_hi_1, SLICE_SAMPLES);
+    float2 centre = (float2(q0_) + (1.0).xx);
+    const EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e51 = epipolar_block_slicesX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, centre, SLICES);
+    float4 line_lo_1 = epipolar_samples.Load(int3(uint2(SLICE_SAMPLES, _e51.slices.x), int(0)));
+    float4 line_hi_1 = epipolar_samples.Load(int3(uint2(SLICE_SAMPLES, _e51.slices.y), int(0)));
+    const EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e67 = epipolar_block_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, centre, _e51, line_lo_1, line_hi_1, SLICE_SAMPLES);
+    uint2 loop_bound_4 = uint2(4294967295u, 4294967295u);
+    bool loop_init_4 = true;
+    while(true) {
+        if (all(loop_bound_4 == uint2(0u, 0u))) { break; }
+        loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
+        if (!loop_init_4) {
+            uint _e99 = j;
+            j = (_e99 + 1u);
+        }
+        loop_init_4 = false;
+        uint _e69 = j;
+        if ((_e69 < 4u)) {
+        } else {
+            break;
+        }
+        {
+            uint _e73 = j;
+            uint _e77 = j;
+            uint _e82 = j;
+            float4 v_11 = epipolar_samples.Load(int3(uint2((_e67.k[min(uint(naga_div(_e73, 2u)), 1u)] + naga_mod(_e77, 2u)), _e67.slices[min(uint(naga_div(_e82, 2u)), 1u)]), int(0)));
+            uint _e91 = j;
+            depths[min(uint(_e91), 3u)] = v_11.w;
+            uint _e95 = j;
+            light[min(uint(_e95), 3u)] = v_11.xyz;
+        }
+    }
+    const float4 _e104 = epipolar_block_weightsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e67, float2(0.0, 0.0));
     uint2 loop_bound_5 = uint2(4294967295u, 4294967295u);
     bool loop_init_5 = true;
     while(true) {
         if (all(loop_bound_5 == uint2(0u, 0u))) { break; }
         loop_bound_5 -= uint2(loop_bound_5.y == 0u, 1u);
         if (!loop_init_5) {
-            uint _e93 = j;
-            j = (_e93 + 1u);
+            uint _e137 = i;
+            i = (_e137 + 1u);
         }
         loop_init_5 = false;
-        uint _e63 = j;
-        if ((_e63 < 4u)) {
+        uint _e106 = i;
+        if ((_e106 < 4u)) {
         } else {
             break;
         }
         {
-            uint _e67 = j;
-            uint _e71 = j;
-            uint _e76 = j;
-            float4 v_11 = epipolar_samples.Load(int3(uint2((_e61.k[min(uint(naga_div(_e67, 2u)), 1u)] + naga_mod(_e71, 2u)), _e61.slices[min(uint(naga_div(_e76, 2u)), 1u)]), int(0)));
-            uint _e85 = j;
-            depths[min(uint(_e85), 3u)] = v_11.w;
-            uint _e89 = j;
-            light[min(uint(_e89), 3u)] = v_11.xyz;
+            uint _e109 = i;
+            uint _e112 = i;
+            uint2 q_4 = (q0_ + uint2(naga_mod(_e109, UNWARP_BLOCK), naga_div(_e112, UNWARP_BLOCK)));
+            if ((q_4.x < screen.x)) {
+                local_1 = (q_4.y < screen.y);
+            } else {
+                local_1 = false;
+            }
+            bool _e126 = local_1;
+            if (_e126) {
+                const float4 _e133 = epipolar_block_weightsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e67, ((float2(q_4) + float2(0.5, 0.5)) - centre));
+                float4 _e134 = depths;
+                float3 _e135[4] = light;
+                unwarp_pixel(q_4, _e133, _e104, _e134, _e135);
+            }
         }
     }
-    float4 _e96 = depths;
-    float3 _e97[4] = light;
-    unwarp_pixel(q_4, _e61.w, _e96, _e97);
     return;
 }

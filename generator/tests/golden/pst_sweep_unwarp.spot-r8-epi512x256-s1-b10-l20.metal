@@ -72,10 +72,18 @@ struct EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
 struct type_9 {
     metal::float3 inner[4];
 };
-struct EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
+struct EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
     metal::uint2 slices;
     metal::uint2 k;
-    metal::float4 w;
+    float fs;
+    char _pad3[4];
+    metal::float2 gs;
+    metal::float2 fk;
+    metal::float2 gk_lo;
+    metal::float2 gk_hi;
+    metal::float2 fs_range;
+    metal::float2 fk_min;
+    metal::float2 fk_max;
 };
 struct FallbackCount {
     metal::atomic_uint listed;
@@ -105,6 +113,7 @@ constant float DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX = 0.1;
 constant uint SLICES = 512u;
 constant uint SLICE_SAMPLES = 256u;
 constant uint SLICE_LANES = 32u;
+constant uint UNWARP_BLOCK = 2u;
 constant uint STEP = 1u;
 constant uint SLICE_RUNS = 256u;
 constant float DEPTH_BREAK = 0.1;
@@ -129,8 +138,8 @@ metal::float2 shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
     metal::float3 ls
 ) {
     float z_2 = metal::max(ls.z, 0.000001);
-    float t_5 = v_1.proj.x;
-    return metal::float2(0.5 + ((0.5 * ls.x) / (z_2 * t_5)), 0.5 - ((0.5 * ls.y) / (z_2 * t_5)));
+    float t_3 = v_1.proj.x;
+    return metal::float2(0.5 + ((0.5 * ls.x) / (z_2 * t_3)), 0.5 - ((0.5 * ls.y) / (z_2 * t_3)));
 }
 
 uint naga_f2u32(float value) {
@@ -144,10 +153,10 @@ float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
 ) {
     bool outside = (((uv.x < 0.0) | (uv.x > 1.0)) | (uv.y < 0.0)) | (uv.y > 1.0);
     uint n_3 = v_2.size.x;
-    uint x_5 = metal::min(naga_f2u32(uv.x * static_cast<float>(n_3)), n_3 - 1u);
+    uint x_7 = metal::min(naga_f2u32(uv.x * static_cast<float>(n_3)), n_3 - 1u);
     uint y_1 = metal::min(naga_f2u32(uv.y * static_cast<float>(n_3)), n_3 - 1u);
     uint clamped_lod_e36 = metal::min(uint(0), sm.get_num_mip_levels() - 1);
-    metal::float4 _e36 = sm.read(metal::min(metal::uint2(metal::uint2(x_5, y_1)), metal::uint2(sm.get_width(clamped_lod_e36), sm.get_height(clamped_lod_e36)) - 1), clamped_lod_e36);
+    metal::float4 _e36 = sm.read(metal::min(metal::uint2(metal::uint2(x_7, y_1)), metal::uint2(sm.get_width(clamped_lod_e36), sm.get_height(clamped_lod_e36)) - 1), clamped_lod_e36);
     return outside ? 2.0 : _e36.x;
 }
 
@@ -245,11 +254,11 @@ float transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     float sigma_t,
     float len
 ) {
-    float x_6 = sigma_t * len;
-    if (x_6 < 0.0001) {
-        return len * (1.0 - (0.5 * x_6));
+    float x_8 = sigma_t * len;
+    if (x_8 < 0.0001) {
+        return len * (1.0 - (0.5 * x_8));
     }
-    return (1.0 - metal::exp(-(x_6))) / sigma_t;
+    return (1.0 - metal::exp(-(x_8))) / sigma_t;
 }
 
 float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
@@ -266,8 +275,8 @@ float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     float cos_inner,
     float cos_outer
 ) {
-    float x_7 = metal::clamp((cos_angle - cos_outer) / (cos_inner - cos_outer), 0.0, 1.0);
-    return ((cos_inner - cos_outer) <= 0.000001) ? ((cos_angle >= cos_outer) ? 1.0 : 0.0) : ((x_7 * x_7) * (3.0 - (2.0 * x_7)));
+    float x_9 = metal::clamp((cos_angle - cos_outer) / (cos_inner - cos_outer), 0.0, 1.0);
+    return ((cos_inner - cos_outer) <= 0.000001) ? ((cos_angle >= cos_outer) ? 1.0 : 0.0) : ((x_9 * x_9) * (3.0 - (2.0 * x_9)));
 }
 
 float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
@@ -280,8 +289,8 @@ float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     float cos_outer_1,
     metal::float4 medium
 ) {
-    metal::float3 x_8 = eye + (dir * t);
-    metal::float3 to_x = x_8 - light_pos;
+    metal::float3 x_10 = eye + (dir * t);
+    metal::float3 to_x = x_10 - light_pos;
     float d2_ = metal::max(metal::dot(to_x, to_x), 0.000000000001);
     float d_2 = metal::sqrt(d2_);
     metal::float3 travel = to_x / metal::float3(d_2);
@@ -426,8 +435,8 @@ metal::float3 screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     metal::float2 p_2
 ) {
     metal::float2 ndc = metal::float2(((2.0 * p_2.x) / static_cast<float>(f_3.sizes.x)) - 1.0, 1.0 - ((2.0 * p_2.y) / static_cast<float>(f_3.sizes.y)));
-    float t_6 = f_3.cam_forward.w;
-    return metal::normalize((f_3.cam_forward.xyz + (f_3.cam_right.xyz * ((ndc.x * t_6) * f_3.cam_right.w))) + (f_3.cam_up.xyz * (ndc.y * t_6)));
+    float t_4 = f_3.cam_forward.w;
+    return metal::normalize((f_3.cam_forward.xyz + (f_3.cam_right.xyz * ((ndc.x * t_4) * f_3.cam_right.w))) + (f_3.cam_up.xyz * (ndc.y * t_4)));
 }
 
 float fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
@@ -609,11 +618,11 @@ float ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     uint rows_1 = f_13.sizes.w;
     float phi_1 = metal::atan2(metal::dot(dir_7, f_13.e2_.xyz), metal::dot(dir_7, f_13.e1_.xyz));
     float z_5 = metal::dot(dir_7, f_13.cam_forward.xyz);
-    float t_7 = f_13.cam_forward.w;
-    metal::float2 ndc_1 = metal::float2(metal::dot(dir_7, f_13.cam_right.xyz) / ((z_5 * t_7) * f_13.cam_right.w), metal::dot(dir_7, f_13.cam_up.xyz) / (z_5 * t_7));
+    float t_5 = f_13.cam_forward.w;
+    metal::float2 ndc_1 = metal::float2(metal::dot(dir_7, f_13.cam_right.xyz) / ((z_5 * t_5) * f_13.cam_right.w), metal::dot(dir_7, f_13.cam_up.xyz) / (z_5 * t_5));
     metal::float2 _e41 = screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13);
-    metal::float2 p_7 = metal::float2((ndc_1.x + 1.0) * 0.5, (1.0 - ndc_1.y) * 0.5) * _e41;
-    metal::float2 d_3 = p_7 - f_13.fan_origin.xy;
+    metal::float2 p_5 = metal::float2((ndc_1.x + 1.0) * 0.5, (1.0 - ndc_1.y) * 0.5) * _e41;
+    metal::float2 d_3 = p_5 - f_13.fan_origin.xy;
     metal::float2 ax_1 = f_13.fan_origin.zw;
     float fan = (metal::atan2((ax_1.x * d_3.y) - (ax_1.y * d_3.x), (ax_1.x * d_3.x) + (ax_1.y * d_3.y)) - f_13.fan_angles.x) / f_13.fan_angles.y;
     float yc = (f_13.fan_angles.z > 0.5) ? fan : ((phi_1 - f_13.e1_.w) / f_13.e2_.w);
@@ -644,16 +653,16 @@ float ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(
     float s_2,
     bool spot_4
 ) {
-    bool local_1 = {};
+    bool local_2 = {};
     if (spot_4) {
         float psi = x_1 * delta;
         float den = metal::sin(theta_2 + psi);
         if (!((den <= 0.000001))) {
-            local_1 = (theta_2 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX;
+            local_2 = (theta_2 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX;
         } else {
-            local_1 = true;
+            local_2 = true;
         }
-        bool _e16 = local_1;
+        bool _e16 = local_2;
         if (_e16) {
             return s_2;
         }
@@ -716,18 +725,19 @@ bool depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
     float b_6,
     float depth_break
 ) {
-    bool local_2 = {};
+    bool local_3 = {};
     if (!((a_6 == b_6))) {
-        local_2 = metal::abs(a_6 - b_6) <= (depth_break * metal::min(a_6, b_6));
+        local_3 = metal::abs(a_6 - b_6) <= (depth_break * metal::min(a_6, b_6));
     } else {
-        local_2 = true;
+        local_3 = true;
     }
-    bool _e13 = local_2;
+    bool _e13 = local_3;
     return _e13;
 }
 
 metal::float4 lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
     metal::float4 w_1,
+    metal::float4 support,
     metal::float4 depths_1,
     type_9 light_1,
     float d,
@@ -741,16 +751,17 @@ metal::float4 lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
     uint taps = 0u;
     uint close = 0u;
     uint k_2 = 0u;
-    bool local_3 = {};
     bool local_4 = {};
+    bool local_5 = {};
+    bool local_6 = {};
     uint2 loop_bound_3 = uint2(4294967295u);
     bool loop_init_3 = true;
     while(true) {
         if (metal::all(loop_bound_3 == uint2(0u))) { break; }
         loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
         if (!loop_init_3) {
-            uint _e63 = k_2;
-            k_2 = _e63 + 1u;
+            uint _e72 = k_2;
+            k_2 = _e72 + 1u;
         }
         loop_init_3 = false;
         uint _e6 = k_2;
@@ -759,61 +770,70 @@ metal::float4 lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
             break;
         }
         {
-            uint _e10 = taps;
-            uint _e12 = k_2;
-            taps = _e10 + ((w_1[metal::min(unsigned(_e12), 3u)] > 0.0) ? 1u : 0u);
-            uint _e20 = k_2;
-            if (w_1[metal::min(unsigned(_e20), 3u)] > 0.0) {
-                uint _e25 = k_2;
-                bool _e29 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(depths_1[metal::min(unsigned(_e25), 3u)], d, depth_break_1);
-                local_3 = _e29;
+            uint _e10 = k_2;
+            bool _e14 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(depths_1[metal::min(unsigned(_e10), 3u)], d, depth_break_1);
+            uint _e16 = taps;
+            uint _e18 = k_2;
+            taps = _e16 + ((support[metal::min(unsigned(_e18), 3u)] > 0.0) ? 1u : 0u);
+            uint _e26 = k_2;
+            if (support[metal::min(unsigned(_e26), 3u)] > 0.0) {
+                local_4 = _e14;
             } else {
-                local_3 = false;
+                local_4 = false;
             }
-            bool _e33 = local_3;
+            bool _e33 = local_4;
             if (_e33) {
                 uint _e35 = close;
                 close = _e35 + 1u;
-                metal::float3 _e40 = sum_2;
+                metal::float3 _e40 = lo_1;
                 uint _e41 = k_2;
-                uint _e43 = k_2;
-                sum_2 = _e40 + (w_1[metal::min(unsigned(_e41), 3u)] * light_1.inner[metal::min(unsigned(_e43), 3u)]);
-                float _e48 = total;
-                uint _e49 = k_2;
-                total = _e48 + w_1[metal::min(unsigned(_e49), 3u)];
-                metal::float3 _e53 = lo_1;
-                uint _e54 = k_2;
-                lo_1 = metal::min(_e53, light_1.inner[metal::min(unsigned(_e54), 3u)]);
-                metal::float3 _e58 = hi_1;
-                uint _e59 = k_2;
-                hi_1 = metal::max(_e58, light_1.inner[metal::min(unsigned(_e59), 3u)]);
+                lo_1 = metal::min(_e40, light_1.inner[metal::min(unsigned(_e41), 3u)]);
+                metal::float3 _e45 = hi_1;
+                uint _e46 = k_2;
+                hi_1 = metal::max(_e45, light_1.inner[metal::min(unsigned(_e46), 3u)]);
+            }
+            uint _e50 = k_2;
+            if (w_1[metal::min(unsigned(_e50), 3u)] > 0.0) {
+                local_5 = _e14;
+            } else {
+                local_5 = false;
+            }
+            bool _e57 = local_5;
+            if (_e57) {
+                metal::float3 _e59 = sum_2;
+                uint _e60 = k_2;
+                uint _e62 = k_2;
+                sum_2 = _e59 + (w_1[metal::min(unsigned(_e60), 3u)] * light_1.inner[metal::min(unsigned(_e62), 3u)]);
+                float _e67 = total;
+                uint _e68 = k_2;
+                total = _e67 + w_1[metal::min(unsigned(_e68), 3u)];
             }
         }
     }
-    float _e65 = total;
-    if (!((_e65 <= 0.0))) {
-        uint _e69 = close;
-        uint _e70 = taps;
-        local_4 = _e69 < metal::min(_e70, 2u);
+    float _e74 = total;
+    if (!((_e74 <= 0.0))) {
+        uint _e78 = close;
+        uint _e79 = taps;
+        local_6 = _e78 < metal::min(_e79, 2u);
     } else {
-        local_4 = true;
+        local_6 = true;
     }
-    bool _e77 = local_4;
-    if (_e77) {
+    bool _e86 = local_6;
+    if (_e86) {
         return metal::float4(0.0, 0.0, 0.0, 0.0);
     }
-    metal::float3 _e83 = hi_1;
-    metal::float3 _e84 = lo_1;
-    metal::float3 spread = _e83 - _e84;
-    float _e93 = hi_1.x;
-    float _e95 = hi_1.y;
-    float _e97 = hi_1.z;
-    if (metal::max(spread.x, metal::max(spread.y, spread.z)) > (light_break * metal::max(_e93, metal::max(_e95, _e97)))) {
+    metal::float3 _e92 = hi_1;
+    metal::float3 _e93 = lo_1;
+    metal::float3 spread = _e92 - _e93;
+    float _e102 = hi_1.x;
+    float _e104 = hi_1.y;
+    float _e106 = hi_1.z;
+    if (metal::max(spread.x, metal::max(spread.y, spread.z)) > (light_break * metal::max(_e102, metal::max(_e104, _e106)))) {
         return metal::float4(0.0, 0.0, 0.0, 0.0);
     }
-    metal::float3 _e107 = sum_2;
-    float _e108 = total;
-    metal::float3 c = _e107 / metal::float3(_e108);
+    metal::float3 _e116 = sum_2;
+    float _e117 = total;
+    metal::float3 c = _e116 / metal::float3(_e117);
     return metal::float4(c.x, c.y, c.z, 1.0);
 }
 
@@ -828,84 +848,104 @@ uint naga_mod(uint lhs, uint rhs) {
     return lhs % metal::select(rhs, 1u, rhs == 0u);
 }
 
-EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_slicesX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
+EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_block_slicesX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
     EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX l_1,
-    metal::uint2 p_4,
+    metal::float2 x_3,
     uint slices
 ) {
     uint s_lo = 0u;
-    float fs = 0.0;
-    EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX t_3 = {};
-    metal::float2 d_4 = (static_cast<metal::float2>(p_4) + metal::float2(0.5, 0.5)) - l_1.origin;
-    float _e12 = epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_1.axis, d_4);
-    float f_21 = ((_e12 - l_1.phi_start) / l_1.dphi) - 0.5;
+    float base = 0.0;
+    EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX b_7 = {};
+    metal::float2 d_4 = x_3 - l_1.origin;
+    float _e7 = epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_1.axis, d_4);
+    float f_21 = ((_e7 - l_1.phi_start) / l_1.dphi) - 0.5;
     if (l_1.wrap != 0u) {
         float fl = metal::floor(f_21);
-        fs = f_21 - fl;
+        base = fl;
         s_lo = naga_mod(static_cast<uint>(as_type<int>(as_type<uint>(naga_f2i32(fl)) + as_type<uint>(static_cast<int>(slices)))), slices);
     } else {
         float fc = metal::clamp(f_21, 0.0, static_cast<float>(slices - 1u));
         s_lo = metal::min(naga_f2u32(fc), slices - 2u);
-        uint _e41 = s_lo;
-        fs = fc - static_cast<float>(_e41);
+        uint _e35 = s_lo;
+        base = static_cast<float>(_e35);
     }
-    uint _e46 = s_lo;
-    uint _e47 = s_lo;
-    t_3.slices = metal::uint2(_e46, naga_mod(_e47 + 1u, slices));
-    float _e53 = fs;
-    float _e56 = fs;
-    t_3.w = metal::float4(1.0 - _e53, _e56, 0.0, 0.0);
-    EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e60 = t_3;
-    return _e60;
+    uint _e39 = s_lo;
+    uint _e40 = s_lo;
+    b_7.slices = metal::uint2(_e39, naga_mod(_e40 + 1u, slices));
+    float _e46 = base;
+    b_7.fs = f_21 - _e46;
+    float _e49 = base;
+    float _e54 = base;
+    b_7.fs_range = (l_1.wrap != 0u) ? metal::float2(-340000000000000000000000000000000000000.0, 340000000000000000000000000000000000000.0) : metal::float2(-(_e49), static_cast<float>(slices - 1u) - _e54);
+    metal::float2 gs = metal::float2(-(d_4.y), d_4.x) / metal::float2(metal::max(metal::dot(d_4, d_4), 0.00000000000000000001) * l_1.dphi);
+    b_7.gs = as_type<metal::float2>(as_type<metal::uint2>(gs) & metal::uint2(4294963200u));
+    EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e81 = b_7;
+    return _e81;
 }
 
-EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
+metal::uint2 naga_f2u32(metal::float2 value) {
+    return static_cast<metal::uint2>(metal::clamp(value, 0.0, 4294967000.0));
+}
+
+EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_block_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
     EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX l_2,
-    metal::uint2 p_5,
-    EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX pair,
+    metal::float2 x_4,
+    EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX block,
     metal::float4 line_lo,
     metal::float4 line_hi,
     uint samples
 ) {
-    EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX t_4 = {};
-    uint j_2 = 0u;
-    metal::float2 d_5 = (static_cast<metal::float2>(p_5) + metal::float2(0.5, 0.5)) - l_2.origin;
-    t_4 = pair;
-    metal::float2 ws = pair.w.xy;
-    uint2 loop_bound_4 = uint2(4294967295u);
-    bool loop_init_4 = true;
-    while(true) {
-        if (metal::all(loop_bound_4 == uint2(0u))) { break; }
-        loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
-        if (!loop_init_4) {
-            uint _e68 = j_2;
-            j_2 = _e68 + 1u;
-        }
-        loop_init_4 = false;
-        uint _e15 = j_2;
-        if (_e15 < 2u) {
-        } else {
-            break;
-        }
-        {
-            uint _e18 = j_2;
-            metal::float4 line = (_e18 == 1u) ? line_hi : line_lo;
-            float g_2 = (metal::dot(d_5, line.xy) - line.z) / metal::max(line.w, 0.00000000000000000001);
-            float gc = metal::clamp(g_2, 0.0, static_cast<float>(samples - 1u));
-            uint k_lo = metal::min(naga_f2u32(gc), samples - 2u);
-            float fk = gc - static_cast<float>(k_lo);
-            uint _e45 = j_2;
-            t_4.k[metal::min(unsigned(_e45), 1u)] = k_lo;
-            uint _e49 = j_2;
-            uint _e52 = j_2;
-            t_4.w[metal::min(unsigned(2u * _e49), 3u)] = ws[metal::min(unsigned(_e52), 1u)] * (1.0 - fk);
-            uint _e59 = j_2;
-            uint _e64 = j_2;
-            t_4.w[metal::min(unsigned((2u * _e59) + 1u), 3u)] = ws[metal::min(unsigned(_e64), 1u)] * fk;
-        }
+    EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX b_8 = {};
+    metal::float2 d_5 = x_4 - l_2.origin;
+    b_8 = block;
+    float s0_ = metal::max(line_lo.w, 0.00000000000000000001);
+    float s1_ = metal::max(line_hi.w, 0.00000000000000000001);
+    metal::float2 g_2 = metal::float2((metal::dot(d_5, line_lo.xy) - line_lo.z) / s0_, (metal::dot(d_5, line_hi.xy) - line_hi.z) / s1_);
+    metal::float2 gc = metal::clamp(g_2, metal::float2(0.0, 0.0), metal::float2(static_cast<float>(samples - 1u)));
+    b_8.k = metal::min(naga_f2u32(gc), metal::uint2(samples - 2u));
+    metal::uint2 _e42 = b_8.k;
+    b_8.fk = g_2 - static_cast<metal::float2>(_e42);
+    metal::uint2 _e47 = b_8.k;
+    b_8.fk_min = -(static_cast<metal::float2>(_e47));
+    metal::uint2 _e56 = b_8.k;
+    b_8.fk_max = metal::float2(static_cast<float>(samples - 1u)) - static_cast<metal::float2>(_e56);
+    b_8.gk_lo = line_lo.xy / metal::float2(s0_);
+    b_8.gk_hi = line_hi.xy / metal::float2(s1_);
+    EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e67 = b_8;
+    return _e67;
+}
+
+metal::float4 epipolar_block_weightsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
+    EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX b_9,
+    metal::float2 o_2
+) {
+    bool local_7 = {};
+    bool local_8 = {};
+    bool local_9 = {};
+    float own_s = metal::clamp(b_9.fs + metal::dot(b_9.gs, o_2), b_9.fs_range.x, b_9.fs_range.y);
+    metal::float2 own_k = metal::clamp(b_9.fk + metal::float2(metal::dot(b_9.gk_lo, o_2), metal::dot(b_9.gk_hi, o_2)), b_9.fk_min, b_9.fk_max);
+    if (!((own_s < -0.5))) {
+        local_7 = own_s > 1.5;
+    } else {
+        local_7 = true;
     }
-    EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e70 = t_4;
-    return _e70;
+    bool _e29 = local_7;
+    if (!(_e29)) {
+        local_8 = metal::any(own_k < metal::float2(-0.5, -0.5));
+    } else {
+        local_8 = true;
+    }
+    bool _e39 = local_8;
+    if (!(_e39)) {
+        local_9 = metal::any(own_k > metal::float2(1.5, 1.5));
+    } else {
+        local_9 = true;
+    }
+    bool beyond = local_9;
+    float fs = metal::clamp(own_s, 0.0, 1.0);
+    metal::float2 fk = metal::clamp(own_k, metal::float2(0.0, 0.0), metal::float2(1.0, 1.0));
+    metal::float4 w_4 = metal::float4((1.0 - fs) * (1.0 - fk.x), (1.0 - fs) * fk.x, fs * (1.0 - fk.y), fs * fk.y);
+    return beyond ? metal::float4(0.0, 0.0, 0.0, 0.0) : w_4;
 }
 
 void fallback_list_reset(
@@ -921,6 +961,7 @@ void fallback_list_reset(
 void unwarp_pixel(
     metal::uint2 q_1,
     metal::float4 w_2,
+    metal::float4 support_1,
     metal::float4 depths_2,
     type_9 light_2,
     metal::texture2d<float, metal::access::sample> depth,
@@ -931,37 +972,37 @@ void unwarp_pixel(
 ) {
     uint clamped_lod_e3 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
     metal::float4 _e3 = depth.read(metal::min(metal::uint2(q_1), metal::uint2(depth.get_width(clamped_lod_e3), depth.get_height(clamped_lod_e3)) - 1), clamped_lod_e3);
-    metal::float4 _e10 = lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(w_2, depths_2, light_2, _e3.x, DEPTH_BREAK, LIGHT_BREAK);
-    if (_e10.w == 0.0) {
-        uint _e17 = metal::atomic_fetch_add_explicit(&fallback_count.listed, 1u, metal::memory_order_relaxed);
-        fallback_pixels[metal::min(unsigned(_e17), (_buffer_sizes.size9 - 0 - 4) / 4)] = q_1.x | (q_1.y << 16u);
-        if (naga_mod(_e17, 64u) == 0u) {
-            uint g_3 = naga_div(_e17, 64u) + 1u;
-            uint _e37 = metal::atomic_fetch_max_explicit(&fallback_count.groups_x, metal::min(g_3, FALLBACK_ROW_GROUPS), metal::memory_order_relaxed);
-            uint _e46 = metal::atomic_fetch_max_explicit(&fallback_count.groups_y, naga_div((g_3 + FALLBACK_ROW_GROUPS) - 1u, FALLBACK_ROW_GROUPS), metal::memory_order_relaxed);
+    metal::float4 _e11 = lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(w_2, support_1, depths_2, light_2, _e3.x, DEPTH_BREAK, LIGHT_BREAK);
+    if (_e11.w == 0.0) {
+        uint _e18 = metal::atomic_fetch_add_explicit(&fallback_count.listed, 1u, metal::memory_order_relaxed);
+        fallback_pixels[metal::min(unsigned(_e18), (_buffer_sizes.size9 - 0 - 4) / 4)] = q_1.x | (q_1.y << 16u);
+        if (naga_mod(_e18, 64u) == 0u) {
+            uint g_3 = naga_div(_e18, 64u) + 1u;
+            uint _e38 = metal::atomic_fetch_max_explicit(&fallback_count.groups_x, metal::min(g_3, FALLBACK_ROW_GROUPS), metal::memory_order_relaxed);
+            uint _e47 = metal::atomic_fetch_max_explicit(&fallback_count.groups_y, naga_div((g_3 + FALLBACK_ROW_GROUPS) - 1u, FALLBACK_ROW_GROUPS), metal::memory_order_relaxed);
             return;
         } else {
             return;
         }
     } else {
-        output.write(_e10, metal::uint2(q_1));
+        output.write(_e11, metal::uint2(q_1));
         return;
     }
 }
 
 metal::float4 factor_at(
-    uint base,
-    float x_3,
+    uint base_1,
+    float x_5,
     uint h,
     device type_11 const& pst_factors,
     constant _mslBufferSizes& _buffer_sizes
 ) {
-    float p_8 = metal::min(metal::clamp(x_3, 0.0, 1.0) * 95.0, 95.0);
-    uint j_3 = metal::min(naga_f2u32(metal::floor(p_8)), 94u);
-    float t_8 = p_8 - static_cast<float>(j_3);
-    metal::float4 _e22 = pst_factors[metal::min(unsigned((base + (2u * j_3)) + h), (_buffer_sizes.size5 - 0 - 16) / 16)];
-    metal::float4 _e34 = pst_factors[metal::min(unsigned((base + (2u * (j_3 + 1u))) + h), (_buffer_sizes.size5 - 0 - 16) / 16)];
-    return (_e22 * (1.0 - t_8)) + (_e34 * t_8);
+    float p_6 = metal::min(metal::clamp(x_5, 0.0, 1.0) * 95.0, 95.0);
+    uint j_2 = metal::min(naga_f2u32(metal::floor(p_6)), 94u);
+    float t_6 = p_6 - static_cast<float>(j_2);
+    metal::float4 _e22 = pst_factors[metal::min(unsigned((base_1 + (2u * j_2)) + h), (_buffer_sizes.size5 - 0 - 16) / 16)];
+    metal::float4 _e34 = pst_factors[metal::min(unsigned((base_1 + (2u * (j_2 + 1u))) + h), (_buffer_sizes.size5 - 0 - 16) / 16)];
+    return (_e22 * (1.0 - t_6)) + (_e34 * t_6);
 }
 
 metal::float4 gamma_at(
@@ -1000,7 +1041,7 @@ metal::float3 pst_row_e(
 
 metal::float4 pst_leaf(
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_20,
-    uint i,
+    uint i_1,
     metal::float3 e_1,
     float delta_2,
     uint h_3,
@@ -1010,20 +1051,20 @@ metal::float4 pst_leaf(
     metal::float4 leaf = metal::float4(0.0, 0.0, 0.0, 0.0);
     uint g_1 = 0u;
     if (false) {
-        metal::float4 _e9 = gamma_at(static_cast<float>(i) * delta_2, h_3, pst_factors, _buffer_sizes);
+        metal::float4 _e9 = gamma_at(static_cast<float>(i_1) * delta_2, h_3, pst_factors, _buffer_sizes);
         return _e9;
     }
     metal::float3 axis_2 = f_20.axis.xyz;
-    uint2 loop_bound_5 = uint2(4294967295u);
-    bool loop_init_5 = true;
+    uint2 loop_bound_4 = uint2(4294967295u);
+    bool loop_init_4 = true;
     while(true) {
-        if (metal::all(loop_bound_5 == uint2(0u))) { break; }
-        loop_bound_5 -= uint2(loop_bound_5.y == 0u, 1u);
-        if (!loop_init_5) {
+        if (metal::all(loop_bound_4 == uint2(0u))) { break; }
+        loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
+        if (!loop_init_4) {
             uint _e54 = g_1;
             g_1 = _e54 + 1u;
         }
-        loop_init_5 = false;
+        loop_init_4 = false;
         uint _e14 = g_1;
         if (_e14 < 2u) {
         } else {
@@ -1032,7 +1073,7 @@ metal::float4 pst_leaf(
         {
             uint _e17 = g_1;
             float q_4 = (_e17 == 0u) ? -0.57735026 : GL2_;
-            float psi_1 = ((static_cast<float>(i) + 0.5) + (0.5 * q_4)) * delta_2;
+            float psi_1 = ((static_cast<float>(i_1) + 0.5) + (0.5 * q_4)) * delta_2;
             metal::float3 l_3 = (-(axis_2) * metal::cos(psi_1)) + (e_1 * metal::sin(psi_1));
             float _e44 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(metal::dot(l_3, f_20.light_dir.xyz), f_20.light_pos.w, f_20.light_dir.w);
             metal::float4 _e46 = leaf;
@@ -1054,8 +1095,8 @@ PstRay pst_ray(
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_22 = frame;
     metal::float3 eye_9 = f_22.eye.xyz;
     metal::float2 ndc_2 = metal::float2(((2.0 * pc_1.x) / static_cast<float>(f_22.sizes.x)) - 1.0, 1.0 - ((2.0 * pc_1.y) / static_cast<float>(f_22.sizes.y)));
-    float t_9 = f_22.cam_forward.w;
-    metal::float3 dir_12 = metal::normalize((f_22.cam_forward.xyz + (f_22.cam_right.xyz * ((ndc_2.x * t_9) * f_22.cam_right.w))) + (f_22.cam_up.xyz * (ndc_2.y * t_9)));
+    float t_7 = f_22.cam_forward.w;
+    metal::float3 dir_12 = metal::normalize((f_22.cam_forward.xyz + (f_22.cam_right.xyz * ((ndc_2.x * t_7) * f_22.cam_right.w))) + (f_22.cam_up.xyz * (ndc_2.y * t_7)));
     float s_4 = metal::min(metal::max(z_1, 0.0), f_22.theta.z) / metal::max(metal::dot(dir_12, f_22.cam_forward.xyz), 0.000001);
     r = PstRay {false, {}, metal::float3(0.0, 0.0, 0.0), eye_9, dir_12, s_4, 0u, 0.0, 0.0, 0.0};
     bool _e67 = in_epipole_discX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_22, pc_1);
@@ -1120,7 +1161,7 @@ metal::float2 pst_terms(
 }
 
 metal::float3 pst_sweep_pixel(
-    uint x_4,
+    uint x_6,
     uint y,
     constant FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX& frame,
     device type_11 const& slices_1,
@@ -1132,12 +1173,12 @@ metal::float3 pst_sweep_pixel(
 ) {
     float sum_3 = 0.0;
     uint h_4 = 0u;
-    metal::float4 p_6 = {};
-    uint i_1 = {};
+    metal::float4 p_4 = {};
+    uint i_2 = {};
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_24 = frame;
     uint clamped_lod_e16 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
-    metal::float4 _e16 = depth.read(metal::min(metal::uint2(metal::uint2(x_4, y)), metal::uint2(depth.get_width(clamped_lod_e16), depth.get_height(clamped_lod_e16)) - 1), clamped_lod_e16);
-    PstRay _e18 = pst_ray(metal::float2(static_cast<float>(x_4) + 0.5, static_cast<float>(y) + 0.5), _e16.x, frame, shadow_map);
+    metal::float4 _e16 = depth.read(metal::min(metal::uint2(metal::uint2(x_6, y)), metal::uint2(depth.get_width(clamped_lod_e16), depth.get_height(clamped_lod_e16)) - 1), clamped_lod_e16);
+    PstRay _e18 = pst_ray(metal::float2(static_cast<float>(x_6) + 0.5, static_cast<float>(y) + 0.5), _e16.x, frame, shadow_map);
     if (_e18.marched) {
         return _e18.color;
     }
@@ -1149,54 +1190,54 @@ metal::float3 pst_sweep_pixel(
     if (_e29 == 0u) {
         return metal::float3(0.0, 0.0, 0.0);
     }
-    uint2 loop_bound_6 = uint2(4294967295u);
-    bool loop_init_6 = true;
+    uint2 loop_bound_5 = uint2(4294967295u);
+    bool loop_init_5 = true;
     while(true) {
-        if (metal::all(loop_bound_6 == uint2(0u))) { break; }
-        loop_bound_6 -= uint2(loop_bound_6.y == 0u, 1u);
-        if (!loop_init_6) {
+        if (metal::all(loop_bound_5 == uint2(0u))) { break; }
+        loop_bound_5 -= uint2(loop_bound_5.y == 0u, 1u);
+        if (!loop_init_5) {
             uint _e78 = h_4;
             h_4 = _e78 + 1u;
         }
-        loop_init_6 = false;
+        loop_init_5 = false;
         uint _e37 = h_4;
         if (_e37 < RANK_VECS) {
         } else {
             break;
         }
         {
-            p_6 = metal::float4(0.0, 0.0, 0.0, 0.0);
-            i_1 = 0u;
-            uint2 loop_bound_7 = uint2(4294967295u);
-            bool loop_init_7 = true;
+            p_4 = metal::float4(0.0, 0.0, 0.0, 0.0);
+            i_2 = 0u;
+            uint2 loop_bound_6 = uint2(4294967295u);
+            bool loop_init_6 = true;
             while(true) {
-                if (metal::all(loop_bound_7 == uint2(0u))) { break; }
-                loop_bound_7 -= uint2(loop_bound_7.y == 0u, 1u);
-                if (!loop_init_7) {
-                    uint _e67 = i_1;
-                    i_1 = _e67 + 1u;
+                if (metal::all(loop_bound_6 == uint2(0u))) { break; }
+                loop_bound_6 -= uint2(loop_bound_6.y == 0u, 1u);
+                if (!loop_init_6) {
+                    uint _e67 = i_2;
+                    i_2 = _e67 + 1u;
                 }
-                loop_init_7 = false;
-                uint _e48 = i_1;
+                loop_init_6 = false;
+                uint _e48 = i_2;
                 if ((_e48 + 1u) < _e29) {
                 } else {
                     break;
                 }
                 {
-                    uint _e53 = i_1;
+                    uint _e53 = i_2;
                     uint clamped_lod_e58 = metal::min(uint(0), rectified.get_num_mip_levels() - 1);
                     metal::float4 _e58 = rectified.read(metal::min(metal::uint2(metal::uint2(_e53, _e18.row)), metal::uint2(rectified.get_width(clamped_lod_e58), rectified.get_height(clamped_lod_e58)) - 1), clamped_lod_e58);
                     if (_e18.d <= _e58.x) {
-                        metal::float4 _e61 = p_6;
-                        uint _e62 = i_1;
+                        metal::float4 _e61 = p_4;
+                        uint _e62 = i_2;
                         uint _e63 = h_4;
                         metal::float4 _e64 = pst_leaf(f_24, _e62, _e28, delta_5, _e63, pst_factors, _buffer_sizes);
-                        p_6 = _e61 + _e64;
+                        p_4 = _e61 + _e64;
                     }
                 }
             }
             float _e70 = sum_3;
-            metal::float4 _e71 = p_6;
+            metal::float4 _e71 = p_4;
             uint _e73 = h_4;
             metal::float4 _e74 = beta_at(_e18.theta, _e73, pst_factors, _buffer_sizes);
             sum_3 = _e70 + metal::dot(_e71, _e74);
@@ -1223,59 +1264,93 @@ kernel void pst_sweep_unwarp(
     metal::float4 depths = metal::float4(0.0, 0.0, 0.0, 0.0);
     type_9 light = {};
     uint j = 0u;
+    uint i = 0u;
+    bool local_1 = {};
     uint _e6 = frame.sizes.x;
     uint _e10 = frame.sizes.y;
     metal::uint2 screen = metal::uint2(_e6, _e10);
-    metal::uint2 q_5 = id.xy;
-    if (!((q_5.x >= screen.x))) {
-        local = q_5.y >= screen.y;
+    metal::uint2 q0_ = id.xy * UNWARP_BLOCK;
+    if (!((q0_.x >= screen.x))) {
+        local = q0_.y >= screen.y;
     } else {
         local = true;
     }
-    bool _e24 = local;
-    if (_e24) {
+    bool _e26 = local;
+    if (_e26) {
         return;
     }
-    uint clamped_lod_e30 = metal::min(uint(0), epipolar_samples.get_num_mip_levels() - 1);
-    metal::float4 head_1 = epipolar_samples.read(metal::min(metal::uint2(metal::uint2(0u, 512u)), metal::uint2(epipolar_samples.get_width(clamped_lod_e30), epipolar_samples.get_height(clamped_lod_e30)) - 1), clamped_lod_e30);
-    uint clamped_lod_e36 = metal::min(uint(0), epipolar_samples.get_num_mip_levels() - 1);
-    metal::float4 angles = epipolar_samples.read(metal::min(metal::uint2(metal::uint2(1u, 512u)), metal::uint2(epipolar_samples.get_width(clamped_lod_e36), epipolar_samples.get_height(clamped_lod_e36)) - 1), clamped_lod_e36);
+    uint clamped_lod_e32 = metal::min(uint(0), epipolar_samples.get_num_mip_levels() - 1);
+    metal::float4 head_1 = epipolar_samples.read(metal::min(metal::uint2(metal::uint2(0u, 512u)), metal::uint2(epipolar_samples.get_width(clamped_lod_e32), epipolar_samples.get_height(clamped_lod_e32)) - 1), clamped_lod_e32);
+    uint clamped_lod_e38 = metal::min(uint(0), epipolar_samples.get_num_mip_levels() - 1);
+    metal::float4 angles = epipolar_samples.read(metal::min(metal::uint2(metal::uint2(1u, 512u)), metal::uint2(epipolar_samples.get_width(clamped_lod_e38), epipolar_samples.get_height(clamped_lod_e38)) - 1), clamped_lod_e38);
     EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX lines = EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {head_1.xy, head_1.zw, angles.x, angles.y, naga_f2u32(angles.z)};
-    EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e45 = epipolar_slicesX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, q_5, SLICES);
-    uint clamped_lod_e52 = metal::min(uint(0), epipolar_samples.get_num_mip_levels() - 1);
-    metal::float4 line_lo_1 = epipolar_samples.read(metal::min(metal::uint2(metal::uint2(SLICE_SAMPLES, _e45.slices.x)), metal::uint2(epipolar_samples.get_width(clamped_lod_e52), epipolar_samples.get_height(clamped_lod_e52)) - 1), clamped_lod_e52);
-    uint clamped_lod_e59 = metal::min(uint(0), epipolar_samples.get_num_mip_levels() - 1);
-    metal::float4 line_hi_1 = epipolar_samples.read(metal::min(metal::uint2(metal::uint2(SLICE_SAMPLES, _e45.slices.y)), metal::uint2(epipolar_samples.get_width(clamped_lod_e59), epipolar_samples.get_height(clamped_lod_e59)) - 1), clamped_lod_e59);
-    EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e61 = epipolar_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, q_5, _e45, line_lo_1, line_hi_1, SLICE_SAMPLES);
+    metal::float2 centre = static_cast<metal::float2>(q0_) + metal::float2(1.0);
+    EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e51 = epipolar_block_slicesX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, centre, SLICES);
+    uint clamped_lod_e58 = metal::min(uint(0), epipolar_samples.get_num_mip_levels() - 1);
+    metal::float4 line_lo_1 = epipolar_samples.read(metal::min(metal::uint2(metal::uint2(SLICE_SAMPLES, _e51.slices.x)), metal::uint2(epipolar_samples.get_width(clamped_lod_e58), epipolar_samples.get_height(clamped_lod_e58)) - 1), clamped_lod_e58);
+    uint clamped_lod_e65 = metal::min(uint(0), epipolar_samples.get_num_mip_levels() - 1);
+    metal::float4 line_hi_1 = epipolar_samples.read(metal::min(metal::uint2(metal::uint2(SLICE_SAMPLES, _e51.slices.y)), metal::uint2(epipolar_samples.get_width(clamped_lod_e65), epipolar_samples.get_height(clamped_lod_e65)) - 1), clamped_lod_e65);
+    EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e67 = epipolar_block_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, centre, _e51, line_lo_1, line_hi_1, SLICE_SAMPLES);
+    uint2 loop_bound_7 = uint2(4294967295u);
+    bool loop_init_7 = true;
+    while(true) {
+        if (metal::all(loop_bound_7 == uint2(0u))) { break; }
+        loop_bound_7 -= uint2(loop_bound_7.y == 0u, 1u);
+        if (!loop_init_7) {
+            uint _e99 = j;
+            j = _e99 + 1u;
+        }
+        loop_init_7 = false;
+        uint _e69 = j;
+        if (_e69 < 4u) {
+        } else {
+            break;
+        }
+        {
+            uint _e73 = j;
+            uint _e77 = j;
+            uint _e82 = j;
+            uint clamped_lod_e89 = metal::min(uint(0), epipolar_samples.get_num_mip_levels() - 1);
+            metal::float4 v_11 = epipolar_samples.read(metal::min(metal::uint2(metal::uint2(_e67.k[metal::min(unsigned(naga_div(_e73, 2u)), 1u)] + naga_mod(_e77, 2u), _e67.slices[metal::min(unsigned(naga_div(_e82, 2u)), 1u)])), metal::uint2(epipolar_samples.get_width(clamped_lod_e89), epipolar_samples.get_height(clamped_lod_e89)) - 1), clamped_lod_e89);
+            uint _e91 = j;
+            depths[metal::min(unsigned(_e91), 3u)] = v_11.w;
+            uint _e95 = j;
+            light.inner[metal::min(unsigned(_e95), 3u)] = v_11.xyz;
+        }
+    }
+    metal::float4 _e104 = epipolar_block_weightsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e67, metal::float2(0.0, 0.0));
     uint2 loop_bound_8 = uint2(4294967295u);
     bool loop_init_8 = true;
     while(true) {
         if (metal::all(loop_bound_8 == uint2(0u))) { break; }
         loop_bound_8 -= uint2(loop_bound_8.y == 0u, 1u);
         if (!loop_init_8) {
-            uint _e93 = j;
-            j = _e93 + 1u;
+            uint _e137 = i;
+            i = _e137 + 1u;
         }
         loop_init_8 = false;
-        uint _e63 = j;
-        if (_e63 < 4u) {
+        uint _e106 = i;
+        if (_e106 < 4u) {
         } else {
             break;
         }
         {
-            uint _e67 = j;
-            uint _e71 = j;
-            uint _e76 = j;
-            uint clamped_lod_e83 = metal::min(uint(0), epipolar_samples.get_num_mip_levels() - 1);
-            metal::float4 v_11 = epipolar_samples.read(metal::min(metal::uint2(metal::uint2(_e61.k[metal::min(unsigned(naga_div(_e67, 2u)), 1u)] + naga_mod(_e71, 2u), _e61.slices[metal::min(unsigned(naga_div(_e76, 2u)), 1u)])), metal::uint2(epipolar_samples.get_width(clamped_lod_e83), epipolar_samples.get_height(clamped_lod_e83)) - 1), clamped_lod_e83);
-            uint _e85 = j;
-            depths[metal::min(unsigned(_e85), 3u)] = v_11.w;
-            uint _e89 = j;
-            light.inner[metal::min(unsigned(_e89), 3u)] = v_11.xyz;
+            uint _e109 = i;
+            uint _e112 = i;
+            metal::uint2 q_5 = q0_ + metal::uint2(naga_mod(_e109, UNWARP_BLOCK), naga_div(_e112, UNWARP_BLOCK));
+            if (q_5.x < screen.x) {
+                local_1 = q_5.y < screen.y;
+            } else {
+                local_1 = false;
+            }
+            bool _e126 = local_1;
+            if (_e126) {
+                metal::float4 _e133 = epipolar_block_weightsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e67, (static_cast<metal::float2>(q_5) + metal::float2(0.5, 0.5)) - centre);
+                metal::float4 _e134 = depths;
+                type_9 _e135 = light;
+                unwarp_pixel(q_5, _e133, _e104, _e134, _e135, depth, output, fallback_count, fallback_pixels, _buffer_sizes);
+            }
         }
     }
-    metal::float4 _e96 = depths;
-    type_9 _e97 = light;
-    unwarp_pixel(q_5, _e61.w, _e96, _e97, depth, output, fallback_count, fallback_pixels, _buffer_sizes);
     return;
 }

@@ -61,10 +61,17 @@ struct EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
     wrap: u32,
 }
 
-struct EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
+struct EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
     slices: vec2<u32>,
     k: vec2<u32>,
-    w: vec4<f32>,
+    fs: f32,
+    gs: vec2<f32>,
+    fk: vec2<f32>,
+    gk_lo: vec2<f32>,
+    gk_hi: vec2<f32>,
+    fs_range: vec2<f32>,
+    fk_min: vec2<f32>,
+    fk_max: vec2<f32>,
 }
 
 struct FallbackCount {
@@ -94,6 +101,7 @@ const DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX: f32 = 0.1f;
 const SLICES: u32 = 512u;
 const SLICE_SAMPLES: u32 = 256u;
 const SLICE_LANES: u32 = 32u;
+const UNWARP_BLOCK: u32 = 2u;
 const STEP: u32 = 1u;
 const SLICE_RUNS: u32 = 256u;
 const DEPTH_BREAK: f32 = 0.1f;
@@ -133,16 +141,16 @@ fn shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v: ShadowMapViewX
 
 fn shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_1: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, ls: vec3<f32>) -> vec2<f32> {
     let z_2 = max(ls.z, 0.000001f);
-    let t_5 = v_1.proj.x;
-    return vec2<f32>((0.5f + ((0.5f * ls.x) / (z_2 * t_5))), (0.5f - ((0.5f * ls.y) / (z_2 * t_5))));
+    let t_3 = v_1.proj.x;
+    return vec2<f32>((0.5f + ((0.5f * ls.x) / (z_2 * t_3))), (0.5f - ((0.5f * ls.y) / (z_2 * t_3))));
 }
 
 fn shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_2: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, sm: texture_2d<f32>, uv: vec2<f32>) -> f32 {
     let outside = ((((uv.x < 0f) | (uv.x > 1f)) | (uv.y < 0f)) | (uv.y > 1f));
     let n_3 = v_2.size.x;
-    let x_5 = min(u32((uv.x * f32(n_3))), (n_3 - 1u));
+    let x_7 = min(u32((uv.x * f32(n_3))), (n_3 - 1u));
     let y_1 = min(u32((uv.y * f32(n_3))), (n_3 - 1u));
-    let _e36 = textureLoad(sm, vec2<u32>(x_5, y_1), 0i);
+    let _e36 = textureLoad(sm, vec2<u32>(x_7, y_1), 0i);
     return select(_e36.x, 2f, outside);
 }
 
@@ -213,11 +221,11 @@ fn phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(g: f32, cos_theta: f32) -> f
 }
 
 fn transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t: f32, len: f32) -> f32 {
-    let x_6 = (sigma_t * len);
-    if (x_6 < 0.0001f) {
-        return (len * (1f - (0.5f * x_6)));
+    let x_8 = (sigma_t * len);
+    if (x_8 < 0.0001f) {
+        return (len * (1f - (0.5f * x_8)));
     }
-    return ((1f - exp(-(x_6))) / sigma_t);
+    return ((1f - exp(-(x_8))) / sigma_t);
 }
 
 fn transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1: f32, a: f32, b: f32) -> f32 {
@@ -226,13 +234,13 @@ fn transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1: f32,
 }
 
 fn cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(cos_angle: f32, cos_inner: f32, cos_outer: f32) -> f32 {
-    let x_7 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0f, 1f);
-    return select(((x_7 * x_7) * (3f - (2f * x_7))), select(0f, 1f, (cos_angle >= cos_outer)), ((cos_inner - cos_outer) <= 0.000001f));
+    let x_9 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0f, 1f);
+    return select(((x_9 * x_9) * (3f - (2f * x_9))), select(0f, 1f, (cos_angle >= cos_outer)), ((cos_inner - cos_outer) <= 0.000001f));
 }
 
 fn spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye: vec3<f32>, dir: vec3<f32>, t: f32, light_pos: vec3<f32>, light_dir: vec3<f32>, cos_inner_1: f32, cos_outer_1: f32, medium: vec4<f32>) -> f32 {
-    let x_8 = (eye + (dir * t));
-    let to_x = (x_8 - light_pos);
+    let x_10 = (eye + (dir * t));
+    let to_x = (x_10 - light_pos);
     let d2_ = max(dot(to_x, to_x), 0.000000000001f);
     let d_2 = sqrt(d2_);
     let travel = (to_x / vec3(d_2));
@@ -330,8 +338,8 @@ fn fan_line_midX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(o_1: vec2<f32>, u: 
 
 fn screen_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_3: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, p_2: vec2<f32>) -> vec3<f32> {
     let ndc = vec2<f32>((((2f * p_2.x) / f32(f_3.sizes.x)) - 1f), (1f - ((2f * p_2.y) / f32(f_3.sizes.y))));
-    let t_6 = f_3.cam_forward.w;
-    return normalize(((f_3.cam_forward.xyz + (f_3.cam_right.xyz * ((ndc.x * t_6) * f_3.cam_right.w))) + (f_3.cam_up.xyz * (ndc.y * t_6))));
+    let t_4 = f_3.cam_forward.w;
+    return normalize(((f_3.cam_forward.xyz + (f_3.cam_right.xyz * ((ndc.x * t_4) * f_3.cam_right.w))) + (f_3.cam_up.xyz * (ndc.y * t_4))));
 }
 
 fn fan_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_4: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, row_1: u32) -> f32 {
@@ -449,11 +457,11 @@ fn ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13: FrameX_naga_
     let rows_1 = f_13.sizes.w;
     let phi_1 = atan2(dot(dir_7, f_13.e2_.xyz), dot(dir_7, f_13.e1_.xyz));
     let z_5 = dot(dir_7, f_13.cam_forward.xyz);
-    let t_7 = f_13.cam_forward.w;
-    let ndc_1 = vec2<f32>((dot(dir_7, f_13.cam_right.xyz) / ((z_5 * t_7) * f_13.cam_right.w)), (dot(dir_7, f_13.cam_up.xyz) / (z_5 * t_7)));
+    let t_5 = f_13.cam_forward.w;
+    let ndc_1 = vec2<f32>((dot(dir_7, f_13.cam_right.xyz) / ((z_5 * t_5) * f_13.cam_right.w)), (dot(dir_7, f_13.cam_up.xyz) / (z_5 * t_5)));
     let _e41 = screen_sizeX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13);
-    let p_7 = (vec2<f32>(((ndc_1.x + 1f) * 0.5f), ((1f - ndc_1.y) * 0.5f)) * _e41);
-    let d_3 = (p_7 - f_13.fan_origin.xy);
+    let p_5 = (vec2<f32>(((ndc_1.x + 1f) * 0.5f), ((1f - ndc_1.y) * 0.5f)) * _e41);
+    let d_3 = (p_5 - f_13.fan_origin.xy);
     let ax_1 = f_13.fan_origin.zw;
     let fan = ((atan2(((ax_1.x * d_3.y) - (ax_1.y * d_3.x)), ((ax_1.x * d_3.x) + (ax_1.y * d_3.y))) - f_13.fan_angles.x) / f_13.fan_angles.y);
     let yc = select(((phi_1 - f_13.e1_.w) / f_13.e2_.w), fan, (f_13.fan_angles.z > 0.5f));
@@ -470,17 +478,17 @@ fn ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_14: FrameX_naga_oil
 }
 
 fn ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_15: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_1: f32, delta: f32, theta_2: f32, s_2: f32, spot_4: bool) -> f32 {
-    var local_1: bool;
+    var local_2: bool;
 
     if spot_4 {
         let psi = (x_1 * delta);
         let den = sin((theta_2 + psi));
         if !((den <= 0.000001f)) {
-            local_1 = ((theta_2 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX);
+            local_2 = ((theta_2 + psi) >= PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX);
         } else {
-            local_1 = true;
+            local_2 = true;
         }
-        let _e16 = local_1;
+        let _e16 = local_2;
         if _e16 {
             return s_2;
         }
@@ -513,18 +521,18 @@ fn lit_spanX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_18: FrameX_naga_oil_m
 }
 
 fn depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(a_6: f32, b_6: f32, depth_break: f32) -> bool {
-    var local_2: bool;
+    var local_3: bool;
 
     if !((a_6 == b_6)) {
-        local_2 = (abs((a_6 - b_6)) <= (depth_break * min(a_6, b_6)));
+        local_3 = (abs((a_6 - b_6)) <= (depth_break * min(a_6, b_6)));
     } else {
-        local_2 = true;
+        local_3 = true;
     }
-    let _e13 = local_2;
+    let _e13 = local_3;
     return _e13;
 }
 
-fn lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(w_1: vec4<f32>, depths_1: vec4<f32>, light_1: array<vec3<f32>, 4>, d: f32, depth_break_1: f32, light_break: f32) -> vec4<f32> {
+fn lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(w_1: vec4<f32>, support: vec4<f32>, depths_1: vec4<f32>, light_1: array<vec3<f32>, 4>, d: f32, depth_break_1: f32, light_break: f32) -> vec4<f32> {
     var sum_2: vec3<f32> = vec3<f32>(0f, 0f, 0f);
     var total: f32 = 0f;
     var lo_1: vec3<f32> = vec3<f32>(340000000000000000000000000000000000000f, 340000000000000000000000000000000000000f, 340000000000000000000000000000000000000f);
@@ -532,8 +540,9 @@ fn lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(w_1: vec4<f32>, dep
     var taps: u32 = 0u;
     var close: u32 = 0u;
     var k_2: u32 = 0u;
-    var local_3: bool;
     var local_4: bool;
+    var local_5: bool;
+    var local_6: bool;
 
     loop {
         let _e6 = k_2;
@@ -542,65 +551,74 @@ fn lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(w_1: vec4<f32>, dep
             break;
         }
         {
-            let _e10 = taps;
-            let _e12 = k_2;
-            taps = (_e10 + select(0u, 1u, (w_1[_e12] > 0f)));
-            let _e20 = k_2;
-            if (w_1[_e20] > 0f) {
-                let _e25 = k_2;
-                let _e29 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(depths_1[_e25], d, depth_break_1);
-                local_3 = _e29;
+            let _e10 = k_2;
+            let _e14 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(depths_1[_e10], d, depth_break_1);
+            let _e16 = taps;
+            let _e18 = k_2;
+            taps = (_e16 + select(0u, 1u, (support[_e18] > 0f)));
+            let _e26 = k_2;
+            if (support[_e26] > 0f) {
+                local_4 = _e14;
             } else {
-                local_3 = false;
+                local_4 = false;
             }
-            let _e33 = local_3;
+            let _e33 = local_4;
             if _e33 {
                 let _e35 = close;
                 close = (_e35 + 1u);
-                let _e40 = sum_2;
+                let _e40 = lo_1;
                 let _e41 = k_2;
-                let _e43 = k_2;
-                sum_2 = (_e40 + (w_1[_e41] * light_1[_e43]));
-                let _e48 = total;
-                let _e49 = k_2;
-                total = (_e48 + w_1[_e49]);
-                let _e53 = lo_1;
-                let _e54 = k_2;
-                lo_1 = min(_e53, light_1[_e54]);
-                let _e58 = hi_1;
-                let _e59 = k_2;
-                hi_1 = max(_e58, light_1[_e59]);
+                lo_1 = min(_e40, light_1[_e41]);
+                let _e45 = hi_1;
+                let _e46 = k_2;
+                hi_1 = max(_e45, light_1[_e46]);
+            }
+            let _e50 = k_2;
+            if (w_1[_e50] > 0f) {
+                local_5 = _e14;
+            } else {
+                local_5 = false;
+            }
+            let _e57 = local_5;
+            if _e57 {
+                let _e59 = sum_2;
+                let _e60 = k_2;
+                let _e62 = k_2;
+                sum_2 = (_e59 + (w_1[_e60] * light_1[_e62]));
+                let _e67 = total;
+                let _e68 = k_2;
+                total = (_e67 + w_1[_e68]);
             }
         }
         continuing {
-            let _e63 = k_2;
-            k_2 = (_e63 + 1u);
+            let _e72 = k_2;
+            k_2 = (_e72 + 1u);
         }
     }
-    let _e65 = total;
-    if !((_e65 <= 0f)) {
-        let _e69 = close;
-        let _e70 = taps;
-        local_4 = (_e69 < min(_e70, 2u));
+    let _e74 = total;
+    if !((_e74 <= 0f)) {
+        let _e78 = close;
+        let _e79 = taps;
+        local_6 = (_e78 < min(_e79, 2u));
     } else {
-        local_4 = true;
+        local_6 = true;
     }
-    let _e77 = local_4;
-    if _e77 {
+    let _e86 = local_6;
+    if _e86 {
         return vec4<f32>(0f, 0f, 0f, 0f);
     }
-    let _e83 = hi_1;
-    let _e84 = lo_1;
-    let spread = (_e83 - _e84);
-    let _e93 = hi_1.x;
-    let _e95 = hi_1.y;
-    let _e97 = hi_1.z;
-    if (max(spread.x, max(spread.y, spread.z)) > (light_break * max(_e93, max(_e95, _e97)))) {
+    let _e92 = hi_1;
+    let _e93 = lo_1;
+    let spread = (_e92 - _e93);
+    let _e102 = hi_1.x;
+    let _e104 = hi_1.y;
+    let _e106 = hi_1.z;
+    if (max(spread.x, max(spread.y, spread.z)) > (light_break * max(_e102, max(_e104, _e106)))) {
         return vec4<f32>(0f, 0f, 0f, 0f);
     }
-    let _e107 = sum_2;
-    let _e108 = total;
-    let c = (_e107 / vec3(_e108));
+    let _e116 = sum_2;
+    let _e117 = total;
+    let c = (_e116 / vec3(_e117));
     return vec4<f32>(c.x, c.y, c.z, 1f);
 }
 
@@ -608,70 +626,89 @@ fn epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(axis: vec2<f32>, 
     return atan2(((axis.x * d_1.y) - (axis.y * d_1.x)), ((axis.x * d_1.x) + (axis.y * d_1.y)));
 }
 
-fn epipolar_slicesX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_1: EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX, p_4: vec2<u32>, slices: u32) -> EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
+fn epipolar_block_slicesX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_1: EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX, x_3: vec2<f32>, slices: u32) -> EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
     var s_lo: u32 = 0u;
-    var fs: f32 = 0f;
-    var t_3: EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX;
+    var base: f32 = 0f;
+    var b_7: EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX;
 
-    let d_4 = ((vec2<f32>(p_4) + vec2<f32>(0.5f, 0.5f)) - l_1.origin);
-    let _e12 = epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_1.axis, d_4);
-    let f_21 = (((_e12 - l_1.phi_start) / l_1.dphi) - 0.5f);
+    let d_4 = (x_3 - l_1.origin);
+    let _e7 = epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_1.axis, d_4);
+    let f_21 = (((_e7 - l_1.phi_start) / l_1.dphi) - 0.5f);
     if (l_1.wrap != 0u) {
         let fl = floor(f_21);
-        fs = (f_21 - fl);
+        base = fl;
         s_lo = (u32((i32(fl) + i32(slices))) % slices);
     } else {
         let fc = clamp(f_21, 0f, f32((slices - 1u)));
         s_lo = min(u32(fc), (slices - 2u));
-        let _e41 = s_lo;
-        fs = (fc - f32(_e41));
+        let _e35 = s_lo;
+        base = f32(_e35);
     }
-    let _e46 = s_lo;
-    let _e47 = s_lo;
-    t_3.slices = vec2<u32>(_e46, ((_e47 + 1u) % slices));
-    let _e53 = fs;
-    let _e56 = fs;
-    t_3.w = vec4<f32>((1f - _e53), _e56, 0f, 0f);
-    let _e60 = t_3;
-    return _e60;
+    let _e39 = s_lo;
+    let _e40 = s_lo;
+    b_7.slices = vec2<u32>(_e39, ((_e40 + 1u) % slices));
+    let _e46 = base;
+    b_7.fs = (f_21 - _e46);
+    let _e49 = base;
+    let _e54 = base;
+    b_7.fs_range = select(vec2<f32>(-(_e49), (f32((slices - 1u)) - _e54)), vec2<f32>(-340000000000000000000000000000000000000f, 340000000000000000000000000000000000000f), (l_1.wrap != 0u));
+    let gs = (vec2<f32>(-(d_4.y), d_4.x) / vec2((max(dot(d_4, d_4), 0.00000000000000000001f) * l_1.dphi)));
+    b_7.gs = bitcast<vec2<f32>>((bitcast<vec2<u32>>(gs) & vec2(4294963200u)));
+    let _e81 = b_7;
+    return _e81;
 }
 
-fn epipolar_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_2: EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX, p_5: vec2<u32>, pair: EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX, line_lo: vec4<f32>, line_hi: vec4<f32>, samples: u32) -> EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
-    var t_4: EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX;
-    var j_2: u32 = 0u;
+fn epipolar_block_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_2: EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX, x_4: vec2<f32>, block: EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX, line_lo: vec4<f32>, line_hi: vec4<f32>, samples: u32) -> EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
+    var b_8: EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX;
 
-    let d_5 = ((vec2<f32>(p_5) + vec2<f32>(0.5f, 0.5f)) - l_2.origin);
-    t_4 = pair;
-    let ws = pair.w.xy;
-    loop {
-        let _e15 = j_2;
-        if (_e15 < 2u) {
-        } else {
-            break;
-        }
-        {
-            let _e18 = j_2;
-            let line = select(line_lo, line_hi, (_e18 == 1u));
-            let g_2 = ((dot(d_5, line.xy) - line.z) / max(line.w, 0.00000000000000000001f));
-            let gc = clamp(g_2, 0f, f32((samples - 1u)));
-            let k_lo = min(u32(gc), (samples - 2u));
-            let fk = (gc - f32(k_lo));
-            let _e45 = j_2;
-            t_4.k[_e45] = k_lo;
-            let _e49 = j_2;
-            let _e52 = j_2;
-            t_4.w[(2u * _e49)] = (ws[_e52] * (1f - fk));
-            let _e59 = j_2;
-            let _e64 = j_2;
-            t_4.w[((2u * _e59) + 1u)] = (ws[_e64] * fk);
-        }
-        continuing {
-            let _e68 = j_2;
-            j_2 = (_e68 + 1u);
-        }
+    let d_5 = (x_4 - l_2.origin);
+    b_8 = block;
+    let s0_ = max(line_lo.w, 0.00000000000000000001f);
+    let s1_ = max(line_hi.w, 0.00000000000000000001f);
+    let g_2 = vec2<f32>(((dot(d_5, line_lo.xy) - line_lo.z) / s0_), ((dot(d_5, line_hi.xy) - line_hi.z) / s1_));
+    let gc = clamp(g_2, vec2<f32>(0f, 0f), vec2(f32((samples - 1u))));
+    b_8.k = min(vec2<u32>(gc), vec2((samples - 2u)));
+    let _e42 = b_8.k;
+    b_8.fk = (g_2 - vec2<f32>(_e42));
+    let _e47 = b_8.k;
+    b_8.fk_min = -(vec2<f32>(_e47));
+    let _e56 = b_8.k;
+    b_8.fk_max = (vec2(f32((samples - 1u))) - vec2<f32>(_e56));
+    b_8.gk_lo = (line_lo.xy / vec2(s0_));
+    b_8.gk_hi = (line_hi.xy / vec2(s1_));
+    let _e67 = b_8;
+    return _e67;
+}
+
+fn epipolar_block_weightsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(b_9: EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX, o_2: vec2<f32>) -> vec4<f32> {
+    var local_7: bool;
+    var local_8: bool;
+    var local_9: bool;
+
+    let own_s = clamp((b_9.fs + dot(b_9.gs, o_2)), b_9.fs_range.x, b_9.fs_range.y);
+    let own_k = clamp((b_9.fk + vec2<f32>(dot(b_9.gk_lo, o_2), dot(b_9.gk_hi, o_2))), b_9.fk_min, b_9.fk_max);
+    if !((own_s < -0.5f)) {
+        local_7 = (own_s > 1.5f);
+    } else {
+        local_7 = true;
     }
-    let _e70 = t_4;
-    return _e70;
+    let _e29 = local_7;
+    if !(_e29) {
+        local_8 = any((own_k < vec2<f32>(-0.5f, -0.5f)));
+    } else {
+        local_8 = true;
+    }
+    let _e39 = local_8;
+    if !(_e39) {
+        local_9 = any((own_k > vec2<f32>(1.5f, 1.5f)));
+    } else {
+        local_9 = true;
+    }
+    let beyond = local_9;
+    let fs = clamp(own_s, 0f, 1f);
+    let fk = clamp(own_k, vec2<f32>(0f, 0f), vec2<f32>(1f, 1f));
+    let w_4 = vec4<f32>(((1f - fs) * (1f - fk.x)), ((1f - fs) * fk.x), (fs * (1f - fk.y)), (fs * fk.y));
+    return select(w_4, vec4<f32>(0f, 0f, 0f, 0f), beyond);
 }
 
 fn fallback_list_reset() {
@@ -682,33 +719,33 @@ fn fallback_list_reset() {
     return;
 }
 
-fn unwarp_pixel(q_1: vec2<u32>, w_2: vec4<f32>, depths_2: vec4<f32>, light_2: array<vec3<f32>, 4>) {
+fn unwarp_pixel(q_1: vec2<u32>, w_2: vec4<f32>, support_1: vec4<f32>, depths_2: vec4<f32>, light_2: array<vec3<f32>, 4>) {
     let _e3 = textureLoad(depth, q_1, 0i);
-    let _e10 = lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(w_2, depths_2, light_2, _e3.x, DEPTH_BREAK, LIGHT_BREAK);
-    if (_e10.w == 0f) {
-        let _e17 = atomicAdd((&fallback_count.listed), 1u);
-        fallback_pixels[_e17] = (q_1.x | (q_1.y << 16u));
-        if ((_e17 % 64u) == 0u) {
-            let g_3 = ((_e17 / 64u) + 1u);
-            let _e37 = atomicMax((&fallback_count.groups_x), min(g_3, FALLBACK_ROW_GROUPS));
-            let _e46 = atomicMax((&fallback_count.groups_y), (((g_3 + FALLBACK_ROW_GROUPS) - 1u) / FALLBACK_ROW_GROUPS));
+    let _e11 = lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(w_2, support_1, depths_2, light_2, _e3.x, DEPTH_BREAK, LIGHT_BREAK);
+    if (_e11.w == 0f) {
+        let _e18 = atomicAdd((&fallback_count.listed), 1u);
+        fallback_pixels[_e18] = (q_1.x | (q_1.y << 16u));
+        if ((_e18 % 64u) == 0u) {
+            let g_3 = ((_e18 / 64u) + 1u);
+            let _e38 = atomicMax((&fallback_count.groups_x), min(g_3, FALLBACK_ROW_GROUPS));
+            let _e47 = atomicMax((&fallback_count.groups_y), (((g_3 + FALLBACK_ROW_GROUPS) - 1u) / FALLBACK_ROW_GROUPS));
             return;
         } else {
             return;
         }
     } else {
-        textureStore(output, q_1, _e10);
+        textureStore(output, q_1, _e11);
         return;
     }
 }
 
-fn factor_at(base: u32, x_3: f32, h: u32) -> vec4<f32> {
-    let p_8 = min((clamp(x_3, 0f, 1f) * 95f), 95f);
-    let j_3 = min(u32(floor(p_8)), 94u);
-    let t_8 = (p_8 - f32(j_3));
-    let _e22 = pst_factors[((base + (2u * j_3)) + h)];
-    let _e34 = pst_factors[((base + (2u * (j_3 + 1u))) + h)];
-    return ((_e22 * (1f - t_8)) + (_e34 * t_8));
+fn factor_at(base_1: u32, x_5: f32, h: u32) -> vec4<f32> {
+    let p_6 = min((clamp(x_5, 0f, 1f) * 95f), 95f);
+    let j_2 = min(u32(floor(p_6)), 94u);
+    let t_6 = (p_6 - f32(j_2));
+    let _e22 = pst_factors[((base_1 + (2u * j_2)) + h)];
+    let _e34 = pst_factors[((base_1 + (2u * (j_2 + 1u))) + h)];
+    return ((_e22 * (1f - t_6)) + (_e34 * t_6));
 }
 
 fn gamma_at(v_10: f32, h_1: u32) -> vec4<f32> {
@@ -732,12 +769,12 @@ fn pst_row_e(f_19: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, row_3: u3
     return _e8;
 }
 
-fn pst_leaf(f_20: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, i: u32, e_1: vec3<f32>, delta_2: f32, h_3: u32) -> vec4<f32> {
+fn pst_leaf(f_20: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, i_1: u32, e_1: vec3<f32>, delta_2: f32, h_3: u32) -> vec4<f32> {
     var leaf: vec4<f32> = vec4<f32>(0f, 0f, 0f, 0f);
     var g_1: u32 = 0u;
 
     if false {
-        let _e9 = gamma_at((f32(i) * delta_2), h_3);
+        let _e9 = gamma_at((f32(i_1) * delta_2), h_3);
         return _e9;
     }
     let axis_2 = f_20.axis.xyz;
@@ -750,7 +787,7 @@ fn pst_leaf(f_20: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, i: u32, e_
         {
             let _e17 = g_1;
             let q_4 = select(GL2_, -0.57735026f, (_e17 == 0u));
-            let psi_1 = (((f32(i) + 0.5f) + (0.5f * q_4)) * delta_2);
+            let psi_1 = (((f32(i_1) + 0.5f) + (0.5f * q_4)) * delta_2);
             let l_3 = ((-(axis_2) * cos(psi_1)) + (e_1 * sin(psi_1)));
             let _e44 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(l_3, f_20.light_dir.xyz), f_20.light_pos.w, f_20.light_dir.w);
             let _e46 = leaf;
@@ -772,8 +809,8 @@ fn pst_ray(pc_1: vec2<f32>, z_1: f32) -> PstRay {
     let f_22 = frame;
     let eye_9 = f_22.eye.xyz;
     let ndc_2 = vec2<f32>((((2f * pc_1.x) / f32(f_22.sizes.x)) - 1f), (1f - ((2f * pc_1.y) / f32(f_22.sizes.y))));
-    let t_9 = f_22.cam_forward.w;
-    let dir_12 = normalize(((f_22.cam_forward.xyz + (f_22.cam_right.xyz * ((ndc_2.x * t_9) * f_22.cam_right.w))) + (f_22.cam_up.xyz * (ndc_2.y * t_9))));
+    let t_7 = f_22.cam_forward.w;
+    let dir_12 = normalize(((f_22.cam_forward.xyz + (f_22.cam_right.xyz * ((ndc_2.x * t_7) * f_22.cam_right.w))) + (f_22.cam_up.xyz * (ndc_2.y * t_7))));
     let s_4 = (min(max(z_1, 0f), f_22.theta.z) / max(dot(dir_12, f_22.cam_forward.xyz), 0.000001f));
     r = PstRay(false, vec3<f32>(0f, 0f, 0f), eye_9, dir_12, s_4, 0u, 0f, 0f, 0f);
     let _e67 = in_epipole_discX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_22, pc_1);
@@ -826,15 +863,15 @@ fn pst_terms(r_2: PstRay, row_4: u32, delta_4: f32, n_2: u32) -> vec2<f32> {
     return vec2<f32>((sp * _e54), (sp * _e56));
 }
 
-fn pst_sweep_pixel(x_4: u32, y: u32) -> vec3<f32> {
+fn pst_sweep_pixel(x_6: u32, y: u32) -> vec3<f32> {
     var sum_3: f32 = 0f;
     var h_4: u32 = 0u;
-    var p_6: vec4<f32>;
-    var i_1: u32;
+    var p_4: vec4<f32>;
+    var i_2: u32;
 
     let f_24 = frame;
-    let _e16 = textureLoad(depth, vec2<u32>(x_4, y), 0i);
-    let _e18 = pst_ray(vec2<f32>((f32(x_4) + 0.5f), (f32(y) + 0.5f)), _e16.x);
+    let _e16 = textureLoad(depth, vec2<u32>(x_6, y), 0i);
+    let _e18 = pst_ray(vec2<f32>((f32(x_6) + 0.5f), (f32(y) + 0.5f)), _e16.x);
     if _e18.marched {
         return _e18.color;
     }
@@ -853,32 +890,32 @@ fn pst_sweep_pixel(x_4: u32, y: u32) -> vec3<f32> {
             break;
         }
         {
-            p_6 = vec4<f32>(0f, 0f, 0f, 0f);
-            i_1 = 0u;
+            p_4 = vec4<f32>(0f, 0f, 0f, 0f);
+            i_2 = 0u;
             loop {
-                let _e48 = i_1;
+                let _e48 = i_2;
                 if ((_e48 + 1u) < _e29) {
                 } else {
                     break;
                 }
                 {
-                    let _e53 = i_1;
+                    let _e53 = i_2;
                     let _e58 = textureLoad(rectified, vec2<u32>(_e53, _e18.row), 0i);
                     if (_e18.d <= _e58.x) {
-                        let _e61 = p_6;
-                        let _e62 = i_1;
+                        let _e61 = p_4;
+                        let _e62 = i_2;
                         let _e63 = h_4;
                         let _e64 = pst_leaf(f_24, _e62, _e28, delta_5, _e63);
-                        p_6 = (_e61 + _e64);
+                        p_4 = (_e61 + _e64);
                     }
                 }
                 continuing {
-                    let _e67 = i_1;
-                    i_1 = (_e67 + 1u);
+                    let _e67 = i_2;
+                    i_2 = (_e67 + 1u);
                 }
             }
             let _e70 = sum_3;
-            let _e71 = p_6;
+            let _e71 = p_4;
             let _e73 = h_4;
             let _e74 = beta_at(_e18.theta, _e73);
             sum_3 = (_e70 + dot(_e71, _e74));
@@ -899,50 +936,79 @@ fn pst_sweep_unwarp(@builtin(global_invocation_id) id: vec3<u32>) {
     var depths: vec4<f32> = vec4<f32>(0f, 0f, 0f, 0f);
     var light: array<vec3<f32>, 4>;
     var j: u32 = 0u;
+    var i: u32 = 0u;
+    var local_1: bool;
 
     let _e6 = frame.sizes.x;
     let _e10 = frame.sizes.y;
     let screen = vec2<u32>(_e6, _e10);
-    let q_5 = id.xy;
-    if !((q_5.x >= screen.x)) {
-        local = (q_5.y >= screen.y);
+    let q0_ = (id.xy * UNWARP_BLOCK);
+    if !((q0_.x >= screen.x)) {
+        local = (q0_.y >= screen.y);
     } else {
         local = true;
     }
-    let _e24 = local;
-    if _e24 {
+    let _e26 = local;
+    if _e26 {
         return;
     }
     let head_1 = textureLoad(epipolar_samples, vec2<u32>(0u, 512u), 0i);
     let angles = textureLoad(epipolar_samples, vec2<u32>(1u, 512u), 0i);
     let lines = EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(head_1.xy, head_1.zw, angles.x, angles.y, u32(angles.z));
-    let _e45 = epipolar_slicesX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, q_5, SLICES);
-    let line_lo_1 = textureLoad(epipolar_samples, vec2<u32>(SLICE_SAMPLES, _e45.slices.x), 0i);
-    let line_hi_1 = textureLoad(epipolar_samples, vec2<u32>(SLICE_SAMPLES, _e45.slices.y), 0i);
-    let _e61 = epipolar_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, q_5, _e45, line_lo_1, line_hi_1, SLICE_SAMPLES);
+    let centre = (vec2<f32>(q0_) + vec2(1f));
+    let _e51 = epipolar_block_slicesX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, centre, SLICES);
+    let line_lo_1 = textureLoad(epipolar_samples, vec2<u32>(SLICE_SAMPLES, _e51.slices.x), 0i);
+    let line_hi_1 = textureLoad(epipolar_samples, vec2<u32>(SLICE_SAMPLES, _e51.slices.y), 0i);
+    let _e67 = epipolar_block_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, centre, _e51, line_lo_1, line_hi_1, SLICE_SAMPLES);
     loop {
-        let _e63 = j;
-        if (_e63 < 4u) {
+        let _e69 = j;
+        if (_e69 < 4u) {
         } else {
             break;
         }
         {
-            let _e67 = j;
-            let _e71 = j;
-            let _e76 = j;
-            let v_11 = textureLoad(epipolar_samples, vec2<u32>((_e61.k[(_e67 / 2u)] + (_e71 % 2u)), _e61.slices[(_e76 / 2u)]), 0i);
-            let _e85 = j;
-            depths[_e85] = v_11.w;
-            let _e89 = j;
-            light[_e89] = v_11.xyz;
+            let _e73 = j;
+            let _e77 = j;
+            let _e82 = j;
+            let v_11 = textureLoad(epipolar_samples, vec2<u32>((_e67.k[(_e73 / 2u)] + (_e77 % 2u)), _e67.slices[(_e82 / 2u)]), 0i);
+            let _e91 = j;
+            depths[_e91] = v_11.w;
+            let _e95 = j;
+            light[_e95] = v_11.xyz;
         }
         continuing {
-            let _e93 = j;
-            j = (_e93 + 1u);
+            let _e99 = j;
+            j = (_e99 + 1u);
         }
     }
-    let _e96 = depths;
-    let _e97 = light;
-    unwarp_pixel(q_5, _e61.w, _e96, _e97);
+    let _e104 = epipolar_block_weightsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e67, vec2<f32>(0f, 0f));
+    loop {
+        let _e106 = i;
+        if (_e106 < 4u) {
+        } else {
+            break;
+        }
+        {
+            let _e109 = i;
+            let _e112 = i;
+            let q_5 = (q0_ + vec2<u32>((_e109 % UNWARP_BLOCK), (_e112 / UNWARP_BLOCK)));
+            if (q_5.x < screen.x) {
+                local_1 = (q_5.y < screen.y);
+            } else {
+                local_1 = false;
+            }
+            let _e126 = local_1;
+            if _e126 {
+                let _e133 = epipolar_block_weightsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e67, ((vec2<f32>(q_5) + vec2<f32>(0.5f, 0.5f)) - centre));
+                let _e134 = depths;
+                let _e135 = light;
+                unwarp_pixel(q_5, _e133, _e104, _e134, _e135);
+            }
+        }
+        continuing {
+            let _e137 = i;
+            i = (_e137 + 1u);
+        }
+    }
     return;
 }

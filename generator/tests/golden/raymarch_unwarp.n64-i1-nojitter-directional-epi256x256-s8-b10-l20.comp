@@ -37,10 +37,17 @@ struct EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
     float dphi;
     uint wrap;
 };
-struct EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
+struct EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
     uvec2 slices;
     uvec2 k;
-    vec4 w;
+    float fs;
+    vec2 gs;
+    vec2 fk;
+    vec2 gk_lo;
+    vec2 gk_hi;
+    vec2 fs_range;
+    vec2 fk_min;
+    vec2 fk_max;
 };
 struct EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
     float t_close;
@@ -57,6 +64,7 @@ struct FallbackCount {
 const uint SLICES = 256u;
 const uint SLICE_SAMPLES = 256u;
 const uint SLICE_LANES = 8u;
+const uint UNWARP_BLOCK = 2u;
 const uint STEP = 8u;
 const uint SLICE_RUNS = 32u;
 const float DEPTH_BREAK = 0.1;
@@ -83,8 +91,8 @@ ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX raymarch_shadow_viewX_nag
 vec3 raymarch_pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(RaymarchFrameX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX m_1, uint x, uint y) {
     float ndc_x = (((2.0 * (float(x) + 0.5)) / float(m_1.sizes.x)) - 1.0);
     float ndc_y = (1.0 - ((2.0 * (float(y) + 0.5)) / float(m_1.sizes.y)));
-    float t_4 = m_1.cam_forward.w;
-    return normalize(((m_1.cam_forward.xyz + (m_1.cam_right.xyz * ((ndc_x * t_4) * m_1.cam_right.w))) + (m_1.cam_up.xyz * (ndc_y * t_4))));
+    float t_2 = m_1.cam_forward.w;
+    return normalize(((m_1.cam_forward.xyz + (m_1.cam_right.xyz * ((ndc_x * t_2) * m_1.cam_right.w))) + (m_1.cam_up.xyz * (ndc_y * t_2))));
 }
 
 float pixel_jitterX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(uint x_1, uint y_1) {
@@ -104,17 +112,17 @@ float pixel_jitterX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(uint x_1, uint y
 }
 
 bool depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(float a, float b, float depth_break) {
-    bool local_1 = false;
+    bool local_2 = false;
     if (!((a == b))) {
-        local_1 = (abs((a - b)) <= (depth_break * min(a, b)));
+        local_2 = (abs((a - b)) <= (depth_break * min(a, b)));
     } else {
-        local_1 = true;
+        local_2 = true;
     }
-    bool _e13 = local_1;
+    bool _e13 = local_2;
     return _e13;
 }
 
-vec4 lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(vec4 w, vec4 depths_1, vec3 light_1[4], float d, float depth_break_1, float light_break) {
+vec4 lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(vec4 w, vec4 support, vec4 depths_1, vec3 light_1[4], float d, float depth_break_1, float light_break) {
     vec3 sum = vec3(0.0, 0.0, 0.0);
     float total = 0.0;
     vec3 lo = vec3(3.4e38, 3.4e38, 3.4e38);
@@ -122,13 +130,14 @@ vec4 lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(vec4 w, vec4 dept
     uint taps = 0u;
     uint close = 0u;
     uint k = 0u;
-    bool local_2 = false;
     bool local_3 = false;
+    bool local_4 = false;
+    bool local_5 = false;
     bool loop_init = true;
     while(true) {
         if (!loop_init) {
-            uint _e63 = k;
-            k = (_e63 + 1u);
+            uint _e72 = k;
+            k = (_e72 + 1u);
         }
         loop_init = false;
         uint _e6 = k;
@@ -137,61 +146,70 @@ vec4 lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(vec4 w, vec4 dept
             break;
         }
         {
-            uint _e10 = taps;
-            uint _e12 = k;
-            taps = (_e10 + ((w[_e12] > 0.0) ? 1u : 0u));
-            uint _e20 = k;
-            if ((w[_e20] > 0.0)) {
-                uint _e25 = k;
-                bool _e29 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(depths_1[_e25], d, depth_break_1);
-                local_2 = _e29;
+            uint _e10 = k;
+            bool _e14 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(depths_1[_e10], d, depth_break_1);
+            uint _e16 = taps;
+            uint _e18 = k;
+            taps = (_e16 + ((support[_e18] > 0.0) ? 1u : 0u));
+            uint _e26 = k;
+            if ((support[_e26] > 0.0)) {
+                local_3 = _e14;
             } else {
-                local_2 = false;
+                local_3 = false;
             }
-            bool _e33 = local_2;
+            bool _e33 = local_3;
             if (_e33) {
                 uint _e35 = close;
                 close = (_e35 + 1u);
-                vec3 _e40 = sum;
+                vec3 _e40 = lo;
                 uint _e41 = k;
-                uint _e43 = k;
-                sum = (_e40 + (w[_e41] * light_1[_e43]));
-                float _e48 = total;
-                uint _e49 = k;
-                total = (_e48 + w[_e49]);
-                vec3 _e53 = lo;
-                uint _e54 = k;
-                lo = min(_e53, light_1[_e54]);
-                vec3 _e58 = hi;
-                uint _e59 = k;
-                hi = max(_e58, light_1[_e59]);
+                lo = min(_e40, light_1[_e41]);
+                vec3 _e45 = hi;
+                uint _e46 = k;
+                hi = max(_e45, light_1[_e46]);
+            }
+            uint _e50 = k;
+            if ((w[_e50] > 0.0)) {
+                local_4 = _e14;
+            } else {
+                local_4 = false;
+            }
+            bool _e57 = local_4;
+            if (_e57) {
+                vec3 _e59 = sum;
+                uint _e60 = k;
+                uint _e62 = k;
+                sum = (_e59 + (w[_e60] * light_1[_e62]));
+                float _e67 = total;
+                uint _e68 = k;
+                total = (_e67 + w[_e68]);
             }
         }
     }
-    float _e65 = total;
-    if (!((_e65 <= 0.0))) {
-        uint _e69 = close;
-        uint _e70 = taps;
-        local_3 = (_e69 < min(_e70, 2u));
+    float _e74 = total;
+    if (!((_e74 <= 0.0))) {
+        uint _e78 = close;
+        uint _e79 = taps;
+        local_5 = (_e78 < min(_e79, 2u));
     } else {
-        local_3 = true;
+        local_5 = true;
     }
-    bool _e77 = local_3;
-    if (_e77) {
+    bool _e86 = local_5;
+    if (_e86) {
         return vec4(0.0, 0.0, 0.0, 0.0);
     }
-    vec3 _e83 = hi;
-    vec3 _e84 = lo;
-    vec3 spread = (_e83 - _e84);
-    float _e93 = hi.x;
-    float _e95 = hi.y;
-    float _e97 = hi.z;
-    if ((max(spread.x, max(spread.y, spread.z)) > (light_break * max(_e93, max(_e95, _e97))))) {
+    vec3 _e92 = hi;
+    vec3 _e93 = lo;
+    vec3 spread = (_e92 - _e93);
+    float _e102 = hi.x;
+    float _e104 = hi.y;
+    float _e106 = hi.z;
+    if ((max(spread.x, max(spread.y, spread.z)) > (light_break * max(_e102, max(_e104, _e106))))) {
         return vec4(0.0, 0.0, 0.0, 0.0);
     }
-    vec3 _e107 = sum;
-    float _e108 = total;
-    vec3 c = (_e107 / vec3(_e108));
+    vec3 _e116 = sum;
+    float _e117 = total;
+    vec3 c = (_e116 / vec3(_e117));
     return vec4(c.x, c.y, c.z, 1.0);
 }
 
@@ -199,70 +217,86 @@ float epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(vec2 axis, vec
     return atan(((axis.x * d_1.y) - (axis.y * d_1.x)), ((axis.x * d_1.x) + (axis.y * d_1.y)));
 }
 
-EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_slicesX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX l, uvec2 p, uint slices) {
+EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_block_slicesX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX l, vec2 x_2, uint slices) {
     uint s_lo = 0u;
-    float fs = 0.0;
-    EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX t = EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(uvec2(0u), uvec2(0u), vec4(0.0));
-    vec2 d_2 = ((vec2(p) + vec2(0.5, 0.5)) - l.origin);
-    float _e12 = epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l.axis, d_2);
-    float f = (((_e12 - l.phi_start) / l.dphi) - 0.5);
+    float base = 0.0;
+    EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX b_1 = EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(uvec2(0u), uvec2(0u), 0.0, vec2(0.0), vec2(0.0), vec2(0.0), vec2(0.0), vec2(0.0), vec2(0.0), vec2(0.0));
+    vec2 d_2 = (x_2 - l.origin);
+    float _e7 = epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l.axis, d_2);
+    float f = (((_e7 - l.phi_start) / l.dphi) - 0.5);
     if ((l.wrap != 0u)) {
         float fl = floor(f);
-        fs = (f - fl);
+        base = fl;
         s_lo = (uint((int(fl) + int(slices))) % slices);
     } else {
         float fc = clamp(f, 0.0, float((slices - 1u)));
         s_lo = min(uint(fc), (slices - 2u));
-        uint _e41 = s_lo;
-        fs = (fc - float(_e41));
+        uint _e35 = s_lo;
+        base = float(_e35);
     }
-    uint _e46 = s_lo;
-    uint _e47 = s_lo;
-    t.slices = uvec2(_e46, ((_e47 + 1u) % slices));
-    float _e53 = fs;
-    float _e56 = fs;
-    t.w = vec4((1.0 - _e53), _e56, 0.0, 0.0);
-    EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e60 = t;
-    return _e60;
+    uint _e39 = s_lo;
+    uint _e40 = s_lo;
+    b_1.slices = uvec2(_e39, ((_e40 + 1u) % slices));
+    float _e46 = base;
+    b_1.fs = (f - _e46);
+    float _e49 = base;
+    float _e54 = base;
+    b_1.fs_range = ((l.wrap != 0u) ? vec2(-3.4e38, 3.4e38) : vec2(-(_e49), (float((slices - 1u)) - _e54)));
+    vec2 gs = (vec2(-(d_2.y), d_2.x) / vec2((max(dot(d_2, d_2), 1e-20) * l.dphi)));
+    b_1.gs = uintBitsToFloat((floatBitsToUint(gs) & uvec2(4294963200u)));
+    EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e81 = b_1;
+    return _e81;
 }
 
-EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX l_1, uvec2 p_1, EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX pair, vec4 line_lo, vec4 line_hi, uint samples) {
-    EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX t_1 = EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(uvec2(0u), uvec2(0u), vec4(0.0));
-    uint j_1 = 0u;
-    vec2 d_3 = ((vec2(p_1) + vec2(0.5, 0.5)) - l_1.origin);
-    t_1 = pair;
-    vec2 ws = pair.w.xy;
-    bool loop_init_1 = true;
-    while(true) {
-        if (!loop_init_1) {
-            uint _e68 = j_1;
-            j_1 = (_e68 + 1u);
-        }
-        loop_init_1 = false;
-        uint _e15 = j_1;
-        if ((_e15 < 2u)) {
-        } else {
-            break;
-        }
-        {
-            uint _e18 = j_1;
-            vec4 line = ((_e18 == 1u) ? line_hi : line_lo);
-            float g_1 = ((dot(d_3, line.xy) - line.z) / max(line.w, 1e-20));
-            float gc = clamp(g_1, 0.0, float((samples - 1u)));
-            uint k_lo = min(uint(gc), (samples - 2u));
-            float fk = (gc - float(k_lo));
-            uint _e45 = j_1;
-            t_1.k[_e45] = k_lo;
-            uint _e49 = j_1;
-            uint _e52 = j_1;
-            t_1.w[(2u * _e49)] = (ws[_e52] * (1.0 - fk));
-            uint _e59 = j_1;
-            uint _e64 = j_1;
-            t_1.w[((2u * _e59) + 1u)] = (ws[_e64] * fk);
-        }
+EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_block_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX l_1, vec2 x_3, EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX block, vec4 line_lo, vec4 line_hi, uint samples) {
+    EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX b_2 = EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(uvec2(0u), uvec2(0u), 0.0, vec2(0.0), vec2(0.0), vec2(0.0), vec2(0.0), vec2(0.0), vec2(0.0), vec2(0.0));
+    vec2 d_3 = (x_3 - l_1.origin);
+    b_2 = block;
+    float s0_ = max(line_lo.w, 1e-20);
+    float s1_ = max(line_hi.w, 1e-20);
+    vec2 g_1 = vec2(((dot(d_3, line_lo.xy) - line_lo.z) / s0_), ((dot(d_3, line_hi.xy) - line_hi.z) / s1_));
+    vec2 gc = clamp(g_1, vec2(0.0, 0.0), vec2(float((samples - 1u))));
+    b_2.k = min(uvec2(gc), uvec2((samples - 2u)));
+    uvec2 _e42 = b_2.k;
+    b_2.fk = (g_1 - vec2(_e42));
+    uvec2 _e47 = b_2.k;
+    b_2.fk_min = -(vec2(_e47));
+    uvec2 _e56 = b_2.k;
+    b_2.fk_max = (vec2(float((samples - 1u))) - vec2(_e56));
+    b_2.gk_lo = (line_lo.xy / vec2(s0_));
+    b_2.gk_hi = (line_hi.xy / vec2(s1_));
+    EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e67 = b_2;
+    return _e67;
+}
+
+vec4 epipolar_block_weightsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX b_3, vec2 o) {
+    bool local_6 = false;
+    bool local_7 = false;
+    bool local_8 = false;
+    float own_s = clamp((b_3.fs + dot(b_3.gs, o)), b_3.fs_range.x, b_3.fs_range.y);
+    vec2 own_k = clamp((b_3.fk + vec2(dot(b_3.gk_lo, o), dot(b_3.gk_hi, o))), b_3.fk_min, b_3.fk_max);
+    if (!((own_s < -0.5))) {
+        local_6 = (own_s > 1.5);
+    } else {
+        local_6 = true;
     }
-    EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e70 = t_1;
-    return _e70;
+    bool _e29 = local_6;
+    if (!(_e29)) {
+        local_7 = any(lessThan(own_k, vec2(-0.5, -0.5)));
+    } else {
+        local_7 = true;
+    }
+    bool _e39 = local_7;
+    if (!(_e39)) {
+        local_8 = any(greaterThan(own_k, vec2(1.5, 1.5)));
+    } else {
+        local_8 = true;
+    }
+    bool beyond = local_8;
+    float fs = clamp(own_s, 0.0, 1.0);
+    vec2 fk = clamp(own_k, vec2(0.0, 0.0), vec2(1.0, 1.0));
+    vec4 w_3 = vec4(((1.0 - fs) * (1.0 - fk.x)), ((1.0 - fs) * fk.x), (fs * (1.0 - fk.y)), (fs * fk.y));
+    return (beyond ? vec4(0.0, 0.0, 0.0, 0.0) : w_3);
 }
 
 float phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float g, float cos_theta) {
@@ -271,64 +305,64 @@ float phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float g, float cos_theta)
 }
 
 float transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t, float len) {
-    float x_4 = (sigma_t * len);
-    if ((x_4 < 0.0001)) {
-        return (len * (1.0 - (0.5 * x_4)));
+    float x_6 = (sigma_t * len);
+    if ((x_6 < 0.0001)) {
+        return (len * (1.0 - (0.5 * x_6)));
     }
-    return ((1.0 - exp(-(x_4))) / sigma_t);
+    return ((1.0 - exp(-(x_6))) / sigma_t);
 }
 
-float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t_1, float a_1, float b_1) {
-    float _e7 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1, (b_1 - a_1));
+float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t_1, float a_1, float b_4) {
+    float _e7 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1, (b_4 - a_1));
     return (exp((-(sigma_t_1) * a_1)) * _e7);
 }
 
 float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float cos_angle, float cos_inner, float cos_outer) {
-    float x_5 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0.0, 1.0);
-    return (((cos_inner - cos_outer) <= 1e-6) ? ((cos_angle >= cos_outer) ? 1.0 : 0.0) : ((x_5 * x_5) * (3.0 - (2.0 * x_5))));
+    float x_7 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0.0, 1.0);
+    return (((cos_inner - cos_outer) <= 1e-6) ? ((cos_angle >= cos_outer) ? 1.0 : 0.0) : ((x_7 * x_7) * (3.0 - (2.0 * x_7))));
 }
 
-float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye, vec3 dir, float t_2, vec3 light_pos, vec3 light_dir, float cos_inner_1, float cos_outer_1, vec4 medium) {
-    vec3 x_6 = (eye + (dir * t_2));
-    vec3 to_x = (x_6 - light_pos);
+float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye, vec3 dir, float t, vec3 light_pos, vec3 light_dir, float cos_inner_1, float cos_outer_1, vec4 medium) {
+    vec3 x_8 = (eye + (dir * t));
+    vec3 to_x = (x_8 - light_pos);
     float d2_ = max(dot(to_x, to_x), 1e-12);
     float d_4 = sqrt(d2_);
     vec3 travel = (to_x / vec3(d_4));
     float _e17 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(travel, light_dir), cos_inner_1, cos_outer_1);
     float _e22 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(medium.z, -(dot(travel, dir)));
-    return ((((medium.y * _e22) * _e17) * exp((-(medium.x) * (d_4 + t_2)))) / d2_);
+    return ((((medium.y * _e22) * _e17) * exp((-(medium.x) * (d_4 + t)))) / d2_);
 }
 
-EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye_1, vec3 dir_1, vec3 light_pos_1, float a_2, float b_2, uint n) {
+EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye_1, vec3 dir_1, vec3 light_pos_1, float a_2, float b_5, uint n) {
     float t0_ = dot((light_pos_1 - eye_1), dir_1);
-    float h_1 = max(length(((eye_1 + (dir_1 * t0_)) - light_pos_1)), (0.0001 * max((b_2 - a_2), 1e-6)));
+    float h_1 = max(length(((eye_1 + (dir_1 * t0_)) - light_pos_1)), (0.0001 * max((b_5 - a_2), 1e-6)));
     float theta_a = atan(((a_2 - t0_) / h_1));
-    return EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(t0_, h_1, theta_a, ((atan(((b_2 - t0_) / h_1)) - theta_a) / float(n)));
+    return EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(t0_, h_1, theta_a, ((atan(((b_5 - t0_) / h_1)) - theta_a) / float(n)));
 }
 
-vec2 equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX e, float x_2) {
-    float tau = tan((e.theta_a + (x_2 * e.dtheta)));
+vec2 equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX e, float x_4) {
+    float tau = tan((e.theta_a + (x_4 * e.dtheta)));
     return vec2((e.t_close + (e.dist * tau)), ((e.dtheta * e.dist) * (1.0 + (tau * tau))));
 }
 
-vec3 shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v, vec3 p_2) {
-    vec3 q_1 = (p_2 - v.origin.xyz);
+vec3 shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v, vec3 p) {
+    vec3 q_1 = (p - v.origin.xyz);
     return vec3(dot(q_1, v.right.xyz), dot(q_1, v.up.xyz), dot(q_1, v.forward.xyz));
 }
 
 vec2 shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_1, vec3 ls) {
     float z_1 = max(ls.z, 1e-6);
-    float t_5 = v_1.proj.x;
-    return vec2((0.5 + ((0.5 * ls.x) / (z_1 * t_5))), (0.5 - ((0.5 * ls.y) / (z_1 * t_5))));
+    float t_3 = v_1.proj.x;
+    return vec2((0.5 + ((0.5 * ls.x) / (z_1 * t_3))), (0.5 - ((0.5 * ls.y) / (z_1 * t_3))));
 }
 
 float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_2, sampler2D sm, vec2 uv) {
     bool outside = ((((uv.x < 0.0) || (uv.x > 1.0)) || (uv.y < 0.0)) || (uv.y > 1.0));
     uint n_1 = v_2.size.x;
-    uint x_7 = min(uint((uv.x * float(n_1))), (n_1 - 1u));
+    uint x_9 = min(uint((uv.x * float(n_1))), (n_1 - 1u));
     uint y_3 = min(uint((uv.y * float(n_1))), (n_1 - 1u));
     int _e36_clamped_lod = clamp(0, 0, textureQueryLevels(sm) - 1);
-    vec4 _e36 = texelFetch(sm, clamp(ivec2(uvec2(x_7, y_3)), ivec2(0), textureSize(sm, _e36_clamped_lod) - ivec2(1)), _e36_clamped_lod);
+    vec4 _e36 = texelFetch(sm, clamp(ivec2(uvec2(x_9, y_3)), ivec2(0), textureSize(sm, _e36_clamped_lod) - ivec2(1)), _e36_clamped_lod);
     return (outside ? 2.0 : _e36.x);
 }
 
@@ -346,8 +380,8 @@ float shadow_bias_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMa
     return (v_5.forward.w * texel_1);
 }
 
-float shadow_visibility_forX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_6, sampler2D sm_1, vec3 p_3, bool perspective) {
-    vec3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, p_3);
+float shadow_visibility_forX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_6, sampler2D sm_1, vec3 p_1, bool perspective) {
+    vec3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, p_1);
     float near = v_6.right.w;
     float far = v_6.up.w;
     if (perspective) {
@@ -373,23 +407,23 @@ void fallback_list_reset() {
     return;
 }
 
-void unwarp_pixel(uvec2 q, vec4 w_1, vec4 depths_2, vec3 light_2[4]) {
+void unwarp_pixel(uvec2 q, vec4 w_1, vec4 support_1, vec4 depths_2, vec3 light_2[4]) {
     int _e3_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_1_cs) - 1);
     vec4 _e3 = texelFetch(_group_0_binding_1_cs, clamp(ivec2(q), ivec2(0), textureSize(_group_0_binding_1_cs, _e3_clamped_lod) - ivec2(1)), _e3_clamped_lod);
-    vec4 _e10 = lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(w_1, depths_2, light_2, _e3.x, DEPTH_BREAK, LIGHT_BREAK);
-    if ((_e10.w == 0.0)) {
-        uint _e17 = atomicAdd(_group_0_binding_5_cs.listed, 1u);
-        _group_0_binding_6_cs[_e17] = (q.x | (q.y << 16u));
-        if (((_e17 % 64u) == 0u)) {
-            uint g_2 = ((_e17 / 64u) + 1u);
-            uint _e37 = atomicMax(_group_0_binding_5_cs.groups_x, min(g_2, FALLBACK_ROW_GROUPS));
-            uint _e46 = atomicMax(_group_0_binding_5_cs.groups_y, (((g_2 + FALLBACK_ROW_GROUPS) - 1u) / FALLBACK_ROW_GROUPS));
+    vec4 _e11 = lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(w_1, support_1, depths_2, light_2, _e3.x, DEPTH_BREAK, LIGHT_BREAK);
+    if ((_e11.w == 0.0)) {
+        uint _e18 = atomicAdd(_group_0_binding_5_cs.listed, 1u);
+        _group_0_binding_6_cs[_e18] = (q.x | (q.y << 16u));
+        if (((_e18 % 64u) == 0u)) {
+            uint g_2 = ((_e18 / 64u) + 1u);
+            uint _e38 = atomicMax(_group_0_binding_5_cs.groups_x, min(g_2, FALLBACK_ROW_GROUPS));
+            uint _e47 = atomicMax(_group_0_binding_5_cs.groups_y, (((g_2 + FALLBACK_ROW_GROUPS) - 1u) / FALLBACK_ROW_GROUPS));
             return;
         } else {
             return;
         }
     } else {
-        imageStore(_group_0_binding_3_cs, ivec2(q), _e10);
+        imageStore(_group_0_binding_3_cs, ivec2(q), _e11);
         return;
     }
 }
@@ -400,57 +434,88 @@ void main() {
     vec4 depths = vec4(0.0, 0.0, 0.0, 0.0);
     vec3 light[4] = vec3[4](vec3(0.0), vec3(0.0), vec3(0.0), vec3(0.0));
     uint j = 0u;
+    uint i = 0u;
+    bool local_1 = false;
     uint _e6 = _group_0_binding_0_cs.sizes.x;
     uint _e10 = _group_0_binding_0_cs.sizes.y;
     uvec2 screen = uvec2(_e6, _e10);
-    uvec2 q_2 = id.xy;
-    if (!((q_2.x >= screen.x))) {
-        local = (q_2.y >= screen.y);
+    uvec2 q0_ = (id.xy * UNWARP_BLOCK);
+    if (!((q0_.x >= screen.x))) {
+        local = (q0_.y >= screen.y);
     } else {
         local = true;
     }
-    bool _e24 = local;
-    if (_e24) {
+    bool _e26 = local;
+    if (_e26) {
         return;
     }
-    int _e30_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
-    vec4 head = texelFetch(_group_0_binding_4_cs, clamp(ivec2(uvec2(0u, 256u)), ivec2(0), textureSize(_group_0_binding_4_cs, _e30_clamped_lod) - ivec2(1)), _e30_clamped_lod);
-    int _e36_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
-    vec4 angles = texelFetch(_group_0_binding_4_cs, clamp(ivec2(uvec2(1u, 256u)), ivec2(0), textureSize(_group_0_binding_4_cs, _e36_clamped_lod) - ivec2(1)), _e36_clamped_lod);
+    int _e32_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
+    vec4 head = texelFetch(_group_0_binding_4_cs, clamp(ivec2(uvec2(0u, 256u)), ivec2(0), textureSize(_group_0_binding_4_cs, _e32_clamped_lod) - ivec2(1)), _e32_clamped_lod);
+    int _e38_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
+    vec4 angles = texelFetch(_group_0_binding_4_cs, clamp(ivec2(uvec2(1u, 256u)), ivec2(0), textureSize(_group_0_binding_4_cs, _e38_clamped_lod) - ivec2(1)), _e38_clamped_lod);
     EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX lines = EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(head.xy, head.zw, angles.x, angles.y, uint(angles.z));
-    EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e45 = epipolar_slicesX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, q_2, SLICES);
-    int _e52_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
-    vec4 line_lo_1 = texelFetch(_group_0_binding_4_cs, clamp(ivec2(uvec2(SLICE_SAMPLES, _e45.slices.x)), ivec2(0), textureSize(_group_0_binding_4_cs, _e52_clamped_lod) - ivec2(1)), _e52_clamped_lod);
-    int _e59_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
-    vec4 line_hi_1 = texelFetch(_group_0_binding_4_cs, clamp(ivec2(uvec2(SLICE_SAMPLES, _e45.slices.y)), ivec2(0), textureSize(_group_0_binding_4_cs, _e59_clamped_lod) - ivec2(1)), _e59_clamped_lod);
-    EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e61 = epipolar_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, q_2, _e45, line_lo_1, line_hi_1, SLICE_SAMPLES);
-    bool loop_init_2 = true;
+    vec2 centre = (vec2(q0_) + vec2(1.0));
+    EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e51 = epipolar_block_slicesX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, centre, SLICES);
+    int _e58_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
+    vec4 line_lo_1 = texelFetch(_group_0_binding_4_cs, clamp(ivec2(uvec2(SLICE_SAMPLES, _e51.slices.x)), ivec2(0), textureSize(_group_0_binding_4_cs, _e58_clamped_lod) - ivec2(1)), _e58_clamped_lod);
+    int _e65_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
+    vec4 line_hi_1 = texelFetch(_group_0_binding_4_cs, clamp(ivec2(uvec2(SLICE_SAMPLES, _e51.slices.y)), ivec2(0), textureSize(_group_0_binding_4_cs, _e65_clamped_lod) - ivec2(1)), _e65_clamped_lod);
+    EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e67 = epipolar_block_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, centre, _e51, line_lo_1, line_hi_1, SLICE_SAMPLES);
+    bool loop_init_1 = true;
     while(true) {
-        if (!loop_init_2) {
-            uint _e93 = j;
-            j = (_e93 + 1u);
+        if (!loop_init_1) {
+            uint _e99 = j;
+            j = (_e99 + 1u);
         }
-        loop_init_2 = false;
-        uint _e63 = j;
-        if ((_e63 < 4u)) {
+        loop_init_1 = false;
+        uint _e69 = j;
+        if ((_e69 < 4u)) {
         } else {
             break;
         }
         {
-            uint _e67 = j;
-            uint _e71 = j;
-            uint _e76 = j;
-            int _e83_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
-            vec4 v_7 = texelFetch(_group_0_binding_4_cs, clamp(ivec2(uvec2((_e61.k[(_e67 / 2u)] + (_e71 % 2u)), _e61.slices[(_e76 / 2u)])), ivec2(0), textureSize(_group_0_binding_4_cs, _e83_clamped_lod) - ivec2(1)), _e83_clamped_lod);
-            uint _e85 = j;
-            depths[_e85] = v_7.w;
-            uint _e89 = j;
-            light[_e89] = v_7.xyz;
+            uint _e73 = j;
+            uint _e77 = j;
+            uint _e82 = j;
+            int _e89_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
+            vec4 v_7 = texelFetch(_group_0_binding_4_cs, clamp(ivec2(uvec2((_e67.k[(_e73 / 2u)] + (_e77 % 2u)), _e67.slices[(_e82 / 2u)])), ivec2(0), textureSize(_group_0_binding_4_cs, _e89_clamped_lod) - ivec2(1)), _e89_clamped_lod);
+            uint _e91 = j;
+            depths[_e91] = v_7.w;
+            uint _e95 = j;
+            light[_e95] = v_7.xyz;
         }
     }
-    vec4 _e96 = depths;
-    vec3 _e97[4] = light;
-    unwarp_pixel(q_2, _e61.w, _e96, _e97);
+    vec4 _e104 = epipolar_block_weightsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e67, vec2(0.0, 0.0));
+    bool loop_init_2 = true;
+    while(true) {
+        if (!loop_init_2) {
+            uint _e137 = i;
+            i = (_e137 + 1u);
+        }
+        loop_init_2 = false;
+        uint _e106 = i;
+        if ((_e106 < 4u)) {
+        } else {
+            break;
+        }
+        {
+            uint _e109 = i;
+            uint _e112 = i;
+            uvec2 q_2 = (q0_ + uvec2((_e109 % UNWARP_BLOCK), (_e112 / UNWARP_BLOCK)));
+            if ((q_2.x < screen.x)) {
+                local_1 = (q_2.y < screen.y);
+            } else {
+                local_1 = false;
+            }
+            bool _e126 = local_1;
+            if (_e126) {
+                vec4 _e133 = epipolar_block_weightsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e67, ((vec2(q_2) + vec2(0.5, 0.5)) - centre));
+                vec4 _e134 = depths;
+                vec3 _e135[4] = light;
+                unwarp_pixel(q_2, _e133, _e104, _e134, _e135);
+            }
+        }
+    }
     return;
 }
 

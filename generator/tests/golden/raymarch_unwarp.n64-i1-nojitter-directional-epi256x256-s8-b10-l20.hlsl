@@ -36,10 +36,18 @@ struct EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
     int _end_pad_0;
 };
 
-struct EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
+struct EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
     uint2 slices;
     uint2 k;
-    float4 w;
+    float fs;
+    int _pad3_0;
+    float2 gs;
+    float2 fk;
+    float2 gk_lo;
+    float2 gk_hi;
+    float2 fs_range;
+    float2 fk_min;
+    float2 fk_max;
 };
 
 struct EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
@@ -59,6 +67,7 @@ struct FallbackCount {
 static const uint SLICES = 256u;
 static const uint SLICE_SAMPLES = 256u;
 static const uint SLICE_LANES = 8u;
+static const uint UNWARP_BLOCK = 2u;
 static const uint STEP = 8u;
 static const uint SLICE_RUNS = 32u;
 static const float DEPTH_BREAK = 0.1;
@@ -93,8 +102,8 @@ float3 raymarch_pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(RaymarchF
 {
     float ndc_x = (((2.0 * (float(x) + 0.5)) / float(m_1.sizes.x)) - 1.0);
     float ndc_y = (1.0 - ((2.0 * (float(y) + 0.5)) / float(m_1.sizes.y)));
-    float t_4 = m_1.cam_forward.w;
-    return normalize(((m_1.cam_forward.xyz + (m_1.cam_right.xyz * ((ndc_x * t_4) * m_1.cam_right.w))) + (m_1.cam_up.xyz * (ndc_y * t_4))));
+    float t_2 = m_1.cam_forward.w;
+    return normalize(((m_1.cam_forward.xyz + (m_1.cam_right.xyz * ((ndc_x * t_2) * m_1.cam_right.w))) + (m_1.cam_up.xyz * (ndc_y * t_2))));
 }
 
 float pixel_jitterX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(uint x_1, uint y_1)
@@ -117,18 +126,18 @@ float pixel_jitterX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(uint x_1, uint y
 
 bool depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(float a, float b, float depth_break)
 {
-    bool local_1 = (bool)0;
+    bool local_2 = (bool)0;
 
     if (!((a == b))) {
-        local_1 = (abs((a - b)) <= (depth_break * min(a, b)));
+        local_2 = (abs((a - b)) <= (depth_break * min(a, b)));
     } else {
-        local_1 = true;
+        local_2 = true;
     }
-    bool _e13 = local_1;
+    bool _e13 = local_2;
     return _e13;
 }
 
-float4 lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(float4 w, float4 depths_1, float3 light_1[4], float d, float depth_break_1, float light_break)
+float4 lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(float4 w, float4 support, float4 depths_1, float3 light_1[4], float d, float depth_break_1, float light_break)
 {
     float3 sum = float3(0.0, 0.0, 0.0);
     float total = 0.0;
@@ -137,8 +146,9 @@ float4 lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(float4 w, float
     uint taps = 0u;
     uint close = 0u;
     uint k = 0u;
-    bool local_2 = (bool)0;
     bool local_3 = (bool)0;
+    bool local_4 = (bool)0;
+    bool local_5 = (bool)0;
 
     uint2 loop_bound = uint2(4294967295u, 4294967295u);
     bool loop_init = true;
@@ -146,8 +156,8 @@ float4 lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(float4 w, float
         if (all(loop_bound == uint2(0u, 0u))) { break; }
         loop_bound -= uint2(loop_bound.y == 0u, 1u);
         if (!loop_init) {
-            uint _e63 = k;
-            k = (_e63 + 1u);
+            uint _e72 = k;
+            k = (_e72 + 1u);
         }
         loop_init = false;
         uint _e6 = k;
@@ -156,61 +166,70 @@ float4 lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(float4 w, float
             break;
         }
         {
-            uint _e10 = taps;
-            uint _e12 = k;
-            taps = (_e10 + ((w[min(uint(_e12), 3u)] > 0.0) ? 1u : 0u));
-            uint _e20 = k;
-            if ((w[min(uint(_e20), 3u)] > 0.0)) {
-                uint _e25 = k;
-                const bool _e29 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(depths_1[min(uint(_e25), 3u)], d, depth_break_1);
-                local_2 = _e29;
+            uint _e10 = k;
+            const bool _e14 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(depths_1[min(uint(_e10), 3u)], d, depth_break_1);
+            uint _e16 = taps;
+            uint _e18 = k;
+            taps = (_e16 + ((support[min(uint(_e18), 3u)] > 0.0) ? 1u : 0u));
+            uint _e26 = k;
+            if ((support[min(uint(_e26), 3u)] > 0.0)) {
+                local_3 = _e14;
             } else {
-                local_2 = false;
+                local_3 = false;
             }
-            bool _e33 = local_2;
+            bool _e33 = local_3;
             if (_e33) {
                 uint _e35 = close;
                 close = (_e35 + 1u);
-                float3 _e40 = sum;
+                float3 _e40 = lo;
                 uint _e41 = k;
-                uint _e43 = k;
-                sum = (_e40 + (w[min(uint(_e41), 3u)] * light_1[min(uint(_e43), 3u)]));
-                float _e48 = total;
-                uint _e49 = k;
-                total = (_e48 + w[min(uint(_e49), 3u)]);
-                float3 _e53 = lo;
-                uint _e54 = k;
-                lo = min(_e53, light_1[min(uint(_e54), 3u)]);
-                float3 _e58 = hi;
-                uint _e59 = k;
-                hi = max(_e58, light_1[min(uint(_e59), 3u)]);
+                lo = min(_e40, light_1[min(uint(_e41), 3u)]);
+                float3 _e45 = hi;
+                uint _e46 = k;
+                hi = max(_e45, light_1[min(uint(_e46), 3u)]);
+            }
+            uint _e50 = k;
+            if ((w[min(uint(_e50), 3u)] > 0.0)) {
+                local_4 = _e14;
+            } else {
+                local_4 = false;
+            }
+            bool _e57 = local_4;
+            if (_e57) {
+                float3 _e59 = sum;
+                uint _e60 = k;
+                uint _e62 = k;
+                sum = (_e59 + (w[min(uint(_e60), 3u)] * light_1[min(uint(_e62), 3u)]));
+                float _e67 = total;
+                uint _e68 = k;
+                total = (_e67 + w[min(uint(_e68), 3u)]);
             }
         }
     }
-    float _e65 = total;
-    if (!((_e65 <= 0.0))) {
-        uint _e69 = close;
-        uint _e70 = taps;
-        local_3 = (_e69 < min(_e70, 2u));
+    float _e74 = total;
+    if (!((_e74 <= 0.0))) {
+        uint _e78 = close;
+        uint _e79 = taps;
+        local_5 = (_e78 < min(_e79, 2u));
     } else {
-        local_3 = true;
+        local_5 = true;
     }
-    bool _e77 = local_3;
-    if (_e77) {
+    bool _e86 = local_5;
+    if (_e86) {
         return float4(0.0, 0.0, 0.0, 0.0);
     }
-    float3 _e83 = hi;
-    float3 _e84 = lo;
-    float3 spread = (_e83 - _e84);
-    float _e93 = hi.x;
-    float _e95 = hi.y;
-    float _e97 = hi.z;
-    if ((max(spread.x, max(spread.y, spread.z)) > (light_break * max(_e93, max(_e95, _e97))))) {
+    float3 _e92 = hi;
+    float3 _e93 = lo;
+    float3 spread = (_e92 - _e93);
+    float _e102 = hi.x;
+    float _e104 = hi.y;
+    float _e106 = hi.z;
+    if ((max(spread.x, max(spread.y, spread.z)) > (light_break * max(_e102, max(_e104, _e106))))) {
         return float4(0.0, 0.0, 0.0, 0.0);
     }
-    float3 _e107 = sum;
-    float _e108 = total;
-    float3 c = (_e107 / (_e108).xxx);
+    float3 _e116 = sum;
+    float _e117 = total;
+    float3 c = (_e116 / (_e117).xxx);
     return float4(c.x, c.y, c.z, 1.0);
 }
 
@@ -231,79 +250,98 @@ uint naga_f2u32(float value) {
     return uint(clamp(value, 0.0, 4294967000.0));
 }
 
-EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_slicesX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX l, uint2 p, uint slices)
+EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_block_slicesX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX l, float2 x_2, uint slices)
 {
     uint s_lo = 0u;
-    float fs = 0.0;
-    EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX t = (EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX)0;
+    float base = 0.0;
+    EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX b_1 = (EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX)0;
 
-    float2 d_2 = ((float2(p) + float2(0.5, 0.5)) - l.origin);
-    const float _e12 = epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l.axis, d_2);
-    float f = (((_e12 - l.phi_start) / l.dphi) - 0.5);
+    float2 d_2 = (x_2 - l.origin);
+    const float _e7 = epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l.axis, d_2);
+    float f = (((_e7 - l.phi_start) / l.dphi) - 0.5);
     if ((l.wrap != 0u)) {
         float fl = floor(f);
-        fs = (f - fl);
+        base = fl;
         s_lo = naga_mod(uint(asint(asuint(naga_f2i32(fl)) + asuint(int(slices)))), slices);
     } else {
         float fc = clamp(f, 0.0, float((slices - 1u)));
         s_lo = min(naga_f2u32(fc), (slices - 2u));
-        uint _e41 = s_lo;
-        fs = (fc - float(_e41));
+        uint _e35 = s_lo;
+        base = float(_e35);
     }
-    uint _e46 = s_lo;
-    uint _e47 = s_lo;
-    t.slices = uint2(_e46, naga_mod((_e47 + 1u), slices));
-    float _e53 = fs;
-    float _e56 = fs;
-    t.w = float4((1.0 - _e53), _e56, 0.0, 0.0);
-    EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e60 = t;
-    const EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolartapsx_naga_oil_mod_xonrwc5dumvzduottmfwxa3djnztqx = _e60;
-    return epipolartapsx_naga_oil_mod_xonrwc5dumvzduottmfwxa3djnztqx;
+    uint _e39 = s_lo;
+    uint _e40 = s_lo;
+    b_1.slices = uint2(_e39, naga_mod((_e40 + 1u), slices));
+    float _e46 = base;
+    b_1.fs = (f - _e46);
+    float _e49 = base;
+    float _e54 = base;
+    b_1.fs_range = ((l.wrap != 0u) ? float2(-3.4e38, 3.4e38) : float2(-(_e49), (float((slices - 1u)) - _e54)));
+    float2 gs = (float2(-(d_2.y), d_2.x) / ((max(dot(d_2, d_2), 1e-20) * l.dphi)).xx);
+    b_1.gs = asfloat((asuint(gs) & (4294963200u).xx));
+    EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e81 = b_1;
+    const EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolarblockx_naga_oil_mod_xonrwc5dumvzduottmfwxa3djnztqx = _e81;
+    return epipolarblockx_naga_oil_mod_xonrwc5dumvzduottmfwxa3djnztqx;
 }
 
-EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX l_1, uint2 p_1, EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX pair, float4 line_lo, float4 line_hi, uint samples)
-{
-    EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX t_1 = (EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX)0;
-    uint j_1 = 0u;
+uint2 naga_f2u32(float2 value) {
+    return uint2(clamp(value, 0.0, 4294967000.0));
+}
 
-    float2 d_3 = ((float2(p_1) + float2(0.5, 0.5)) - l_1.origin);
-    t_1 = pair;
-    float2 ws = pair.w.xy;
-    uint2 loop_bound_1 = uint2(4294967295u, 4294967295u);
-    bool loop_init_1 = true;
-    while(true) {
-        if (all(loop_bound_1 == uint2(0u, 0u))) { break; }
-        loop_bound_1 -= uint2(loop_bound_1.y == 0u, 1u);
-        if (!loop_init_1) {
-            uint _e68 = j_1;
-            j_1 = (_e68 + 1u);
-        }
-        loop_init_1 = false;
-        uint _e15 = j_1;
-        if ((_e15 < 2u)) {
-        } else {
-            break;
-        }
-        {
-            uint _e18 = j_1;
-            float4 line_ = ((_e18 == 1u) ? line_hi : line_lo);
-            float g_1 = ((dot(d_3, line_.xy) - line_.z) / max(line_.w, 1e-20));
-            float gc = clamp(g_1, 0.0, float((samples - 1u)));
-            uint k_lo = min(naga_f2u32(gc), (samples - 2u));
-            float fk = (gc - float(k_lo));
-            uint _e45 = j_1;
-            t_1.k[min(uint(_e45), 1u)] = k_lo;
-            uint _e49 = j_1;
-            uint _e52 = j_1;
-            t_1.w[min(uint((2u * _e49)), 3u)] = (ws[min(uint(_e52), 1u)] * (1.0 - fk));
-            uint _e59 = j_1;
-            uint _e64 = j_1;
-            t_1.w[min(uint(((2u * _e59) + 1u)), 3u)] = (ws[min(uint(_e64), 1u)] * fk);
-        }
+EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_block_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX l_1, float2 x_3, EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX block, float4 line_lo, float4 line_hi, uint samples)
+{
+    EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX b_2 = (EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX)0;
+
+    float2 d_3 = (x_3 - l_1.origin);
+    b_2 = block;
+    float s0_ = max(line_lo.w, 1e-20);
+    float s1_ = max(line_hi.w, 1e-20);
+    float2 g_1 = float2(((dot(d_3, line_lo.xy) - line_lo.z) / s0_), ((dot(d_3, line_hi.xy) - line_hi.z) / s1_));
+    float2 gc = clamp(g_1, float2(0.0, 0.0), (float((samples - 1u))).xx);
+    b_2.k = min(naga_f2u32(gc), ((samples - 2u)).xx);
+    uint2 _e42 = b_2.k;
+    b_2.fk = (g_1 - float2(_e42));
+    uint2 _e47 = b_2.k;
+    b_2.fk_min = -(float2(_e47));
+    uint2 _e56 = b_2.k;
+    b_2.fk_max = ((float((samples - 1u))).xx - float2(_e56));
+    b_2.gk_lo = (line_lo.xy / (s0_).xx);
+    b_2.gk_hi = (line_hi.xy / (s1_).xx);
+    EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e67 = b_2;
+    const EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolarblockx_naga_oil_mod_xonrwc5dumvzduottmfwxa3djnztqx_1 = _e67;
+    return epipolarblockx_naga_oil_mod_xonrwc5dumvzduottmfwxa3djnztqx_1;
+}
+
+float4 epipolar_block_weightsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX b_3, float2 o)
+{
+    bool local_6 = (bool)0;
+    bool local_7 = (bool)0;
+    bool local_8 = (bool)0;
+
+    float own_s = clamp((b_3.fs + dot(b_3.gs, o)), b_3.fs_range.x, b_3.fs_range.y);
+    float2 own_k = clamp((b_3.fk + float2(dot(b_3.gk_lo, o), dot(b_3.gk_hi, o))), b_3.fk_min, b_3.fk_max);
+    if (!((own_s < -0.5))) {
+        local_6 = (own_s > 1.5);
+    } else {
+        local_6 = true;
     }
-    EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e70 = t_1;
-    const EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolartapsx_naga_oil_mod_xonrwc5dumvzduottmfwxa3djnztqx_1 = _e70;
-    return epipolartapsx_naga_oil_mod_xonrwc5dumvzduottmfwxa3djnztqx_1;
+    bool _e29 = local_6;
+    if (!(_e29)) {
+        local_7 = any((own_k < float2(-0.5, -0.5)));
+    } else {
+        local_7 = true;
+    }
+    bool _e39 = local_7;
+    if (!(_e39)) {
+        local_8 = any((own_k > float2(1.5, 1.5)));
+    } else {
+        local_8 = true;
+    }
+    bool beyond = local_8;
+    float fs = clamp(own_s, 0.0, 1.0);
+    float2 fk = clamp(own_k, float2(0.0, 0.0), float2(1.0, 1.0));
+    float4 w_3 = float4(((1.0 - fs) * (1.0 - fk.x)), ((1.0 - fs) * fk.x), (fs * (1.0 - fk.y)), (fs * fk.y));
+    return (beyond ? float4(0.0, 0.0, 0.0, 0.0) : w_3);
 }
 
 float phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float g, float cos_theta)
@@ -314,35 +352,35 @@ float phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float g, float cos_theta)
 
 float transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t, float len)
 {
-    float x_4 = (sigma_t * len);
-    if ((x_4 < 0.0001)) {
-        return (len * (1.0 - (0.5 * x_4)));
+    float x_6 = (sigma_t * len);
+    if ((x_6 < 0.0001)) {
+        return (len * (1.0 - (0.5 * x_6)));
     }
-    return ((1.0 - exp(-(x_4))) / sigma_t);
+    return ((1.0 - exp(-(x_6))) / sigma_t);
 }
 
-float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t_1, float a_1, float b_1)
+float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float sigma_t_1, float a_1, float b_4)
 {
-    const float _e7 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1, (b_1 - a_1));
+    const float _e7 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1, (b_4 - a_1));
     return (exp((-(sigma_t_1) * a_1)) * _e7);
 }
 
 float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float cos_angle, float cos_inner, float cos_outer)
 {
-    float x_5 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0.0, 1.0);
-    return (((cos_inner - cos_outer) <= 1e-6) ? ((cos_angle >= cos_outer) ? 1.0 : 0.0) : ((x_5 * x_5) * (3.0 - (2.0 * x_5))));
+    float x_7 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0.0, 1.0);
+    return (((cos_inner - cos_outer) <= 1e-6) ? ((cos_angle >= cos_outer) ? 1.0 : 0.0) : ((x_7 * x_7) * (3.0 - (2.0 * x_7))));
 }
 
-float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye, float3 dir, float t_2, float3 light_pos, float3 light_dir, float cos_inner_1, float cos_outer_1, float4 medium)
+float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye, float3 dir, float t, float3 light_pos, float3 light_dir, float cos_inner_1, float cos_outer_1, float4 medium)
 {
-    float3 x_6 = (eye + (dir * t_2));
-    float3 to_x = (x_6 - light_pos);
+    float3 x_8 = (eye + (dir * t));
+    float3 to_x = (x_8 - light_pos);
     float d2_ = max(dot(to_x, to_x), 1e-12);
     float d_4 = sqrt(d2_);
     float3 travel = (to_x / (d_4).xxx);
     const float _e17 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(travel, light_dir), cos_inner_1, cos_outer_1);
     const float _e22 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(medium.z, -(dot(travel, dir)));
-    return ((((medium.y * _e22) * _e17) * exp((-(medium.x) * (d_4 + t_2)))) / d2_);
+    return ((((medium.y * _e22) * _e17) * exp((-(medium.x) * (d_4 + t)))) / d2_);
 }
 
 EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX ConstructEquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float arg0, float arg1, float arg2, float arg3) {
@@ -354,41 +392,41 @@ EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX ConstructEquiangularX_naga_o
     return ret;
 }
 
-EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye_1, float3 dir_1, float3 light_pos_1, float a_2, float b_2, uint n)
+EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye_1, float3 dir_1, float3 light_pos_1, float a_2, float b_5, uint n)
 {
     float t0_ = dot((light_pos_1 - eye_1), dir_1);
-    float h_1 = max(length(((eye_1 + (dir_1 * t0_)) - light_pos_1)), (0.0001 * max((b_2 - a_2), 1e-6)));
+    float h_1 = max(length(((eye_1 + (dir_1 * t0_)) - light_pos_1)), (0.0001 * max((b_5 - a_2), 1e-6)));
     float theta_a = atan(((a_2 - t0_) / h_1));
-    const EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX equiangularx_naga_oil_mod_xonrwc5dumvzduotnn5sgk3ax = ConstructEquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(t0_, h_1, theta_a, ((atan(((b_2 - t0_) / h_1)) - theta_a) / float(n)));
+    const EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX equiangularx_naga_oil_mod_xonrwc5dumvzduotnn5sgk3ax = ConstructEquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(t0_, h_1, theta_a, ((atan(((b_5 - t0_) / h_1)) - theta_a) / float(n)));
     return equiangularx_naga_oil_mod_xonrwc5dumvzduotnn5sgk3ax;
 }
 
-float2 equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX e, float x_2)
+float2 equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX e, float x_4)
 {
-    float tau = tan((e.theta_a + (x_2 * e.dtheta)));
+    float tau = tan((e.theta_a + (x_4 * e.dtheta)));
     return float2((e.t_close + (e.dist * tau)), ((e.dtheta * e.dist) * (1.0 + (tau * tau))));
 }
 
-float3 shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v, float3 p_2)
+float3 shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v, float3 p)
 {
-    float3 q_1 = (p_2 - v.origin.xyz);
+    float3 q_1 = (p - v.origin.xyz);
     return float3(dot(q_1, v.right.xyz), dot(q_1, v.up.xyz), dot(q_1, v.forward.xyz));
 }
 
 float2 shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_1, float3 ls)
 {
     float z_1 = max(ls.z, 1e-6);
-    float t_5 = v_1.proj.x;
-    return float2((0.5 + ((0.5 * ls.x) / (z_1 * t_5))), (0.5 - ((0.5 * ls.y) / (z_1 * t_5))));
+    float t_3 = v_1.proj.x;
+    return float2((0.5 + ((0.5 * ls.x) / (z_1 * t_3))), (0.5 - ((0.5 * ls.y) / (z_1 * t_3))));
 }
 
 float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_2, Texture2D<float4> sm, float2 uv)
 {
     bool outside = ((((uv.x < 0.0) | (uv.x > 1.0)) | (uv.y < 0.0)) | (uv.y > 1.0));
     uint n_1 = v_2.size.x;
-    uint x_7 = min(naga_f2u32((uv.x * float(n_1))), (n_1 - 1u));
+    uint x_9 = min(naga_f2u32((uv.x * float(n_1))), (n_1 - 1u));
     uint y_3 = min(naga_f2u32((uv.y * float(n_1))), (n_1 - 1u));
-    float4 _e36 = sm.Load(int3(uint2(x_7, y_3), int(0)));
+    float4 _e36 = sm.Load(int3(uint2(x_9, y_3), int(0)));
     return (outside ? 2.0 : _e36.x);
 }
 
@@ -409,9 +447,9 @@ float shadow_bias_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMa
     return (v_5.forward.w * texel_1);
 }
 
-float shadow_visibility_forX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_6, Texture2D<float4> sm_1, float3 p_3, bool perspective)
+float shadow_visibility_forX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_6, Texture2D<float4> sm_1, float3 p_1, bool perspective)
 {
-    const float3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, p_3);
+    const float3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, p_1);
     float near = v_6.right.w;
     float far = v_6.up.w;
     if (perspective) {
@@ -442,23 +480,23 @@ uint naga_div(uint lhs, uint rhs) {
     return lhs / (rhs == 0u ? 1u : rhs);
 }
 
-void unwarp_pixel(uint2 q, float4 w_1, float4 depths_2, float3 light_2[4])
+void unwarp_pixel(uint2 q, float4 w_1, float4 support_1, float4 depths_2, float3 light_2[4])
 {
     float4 _e3 = depth.Load(int3(q, int(0)));
-    const float4 _e10 = lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(w_1, depths_2, light_2, _e3.x, DEPTH_BREAK, LIGHT_BREAK);
-    if ((_e10.w == 0.0)) {
-        uint _e17; fallback_count.InterlockedAdd(0, 1u, _e17);
-        fallback_pixels.Store(_e17*4, asuint((q.x | (q.y << 16u))));
-        if ((naga_mod(_e17, 64u) == 0u)) {
-            uint g_2 = (naga_div(_e17, 64u) + 1u);
-            uint _e37; fallback_count.InterlockedMax(4, min(g_2, FALLBACK_ROW_GROUPS), _e37);
-            uint _e46; fallback_count.InterlockedMax(8, naga_div(((g_2 + FALLBACK_ROW_GROUPS) - 1u), FALLBACK_ROW_GROUPS), _e46);
+    const float4 _e11 = lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(w_1, support_1, depths_2, light_2, _e3.x, DEPTH_BREAK, LIGHT_BREAK);
+    if ((_e11.w == 0.0)) {
+        uint _e18; fallback_count.InterlockedAdd(0, 1u, _e18);
+        fallback_pixels.Store(_e18*4, asuint((q.x | (q.y << 16u))));
+        if ((naga_mod(_e18, 64u) == 0u)) {
+            uint g_2 = (naga_div(_e18, 64u) + 1u);
+            uint _e38; fallback_count.InterlockedMax(4, min(g_2, FALLBACK_ROW_GROUPS), _e38);
+            uint _e47; fallback_count.InterlockedMax(8, naga_div(((g_2 + FALLBACK_ROW_GROUPS) - 1u), FALLBACK_ROW_GROUPS), _e47);
             return;
         } else {
             return;
         }
     } else {
-        output[q] = _e10;
+        output[q] = _e11;
         return;
     }
 }
@@ -480,55 +518,89 @@ void raymarch_unwarp(uint3 id : SV_DispatchThreadID)
     float4 depths = float4(0.0, 0.0, 0.0, 0.0);
     float3 light[4] = (float3[4])0;
     uint j = 0u;
+    uint i = 0u;
+    bool local_1 = (bool)0;
 
     uint _e6 = frame.sizes.x;
     uint _e10 = frame.sizes.y;
     uint2 screen = uint2(_e6, _e10);
-    uint2 q_2 = id.xy;
-    if (!((q_2.x >= screen.x))) {
-        local = (q_2.y >= screen.y);
+    uint2 q0_ = (id.xy * UNWARP_BLOCK);
+    if (!((q0_.x >= screen.x))) {
+        local = (q0_.y >= screen.y);
     } else {
         local = true;
     }
-    bool _e24 = local;
-    if (_e24) {
+    bool _e26 = local;
+    if (_e26) {
         return;
     }
     float4 head = epipolar_samples.Load(int3(uint2(0u, 256u), int(0)));
     float4 angles = epipolar_samples.Load(int3(uint2(1u, 256u), int(0)));
     EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX lines = ConstructEpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(head.xy, head.zw, angles.x, angles.y, naga_f2u32(angles.z));
-    const EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e45 = epipolar_slicesX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, q_2, SLICES);
-    float4 line_lo_1 = epipolar_samples.Load(int3(uint2(SLICE_SAMPLES, _e45.slices.x), int(0)));
-    float4 line_hi_1 = epipolar_samples.Load(int3(uint2(SLICE_SAMPLES, _e45.slices.y), int(0)));
-    const EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e61 = epipolar_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, q_2, _e45, line_lo_1, line_hi_1, SLICE_SAMPLES);
+    float2 centre = (float2(q0_) + (1.0).xx);
+    const EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e51 = epipolar_block_slicesX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, centre, SLICES);
+    float4 line_lo_1 = epipolar_samples.Load(int3(uint2(SLICE_SAMPLES, _e51.slices.x), int(0)));
+    float4 line_hi_1 = epipolar_samples.Load(int3(uint2(SLICE_SAMPLES, _e51.slices.y), int(0)));
+    const EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e67 = epipolar_block_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, centre, _e51, line_lo_1, line_hi_1, SLICE_SAMPLES);
+    uint2 loop_bound_1 = uint2(4294967295u, 4294967295u);
+    bool loop_init_1 = true;
+    while(true) {
+        if (all(loop_bound_1 == uint2(0u, 0u))) { break; }
+        loop_bound_1 -= uint2(loop_bound_1.y == 0u, 1u);
+        if (!loop_init_1) {
+            uint _e99 = j;
+            j = (_e99 + 1u);
+        }
+        loop_init_1 = false;
+        uint _e69 = j;
+        if ((_e69 < 4u)) {
+        } else {
+            break;
+        }
+        {
+            uint _e73 = j;
+            uint _e77 = j;
+            uint _e82 = j;
+            float4 v_7 = epipolar_samples.Load(int3(uint2((_e67.k[min(uint(naga_div(_e73, 2u)), 1u)] + naga_mod(_e77, 2u)), _e67.slices[min(uint(naga_div(_e82, 2u)), 1u)]), int(0)));
+            uint _e91 = j;
+            depths[min(uint(_e91), 3u)] = v_7.w;
+            uint _e95 = j;
+            light[min(uint(_e95), 3u)] = v_7.xyz;
+        }
+    }
+    const float4 _e104 = epipolar_block_weightsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e67, float2(0.0, 0.0));
     uint2 loop_bound_2 = uint2(4294967295u, 4294967295u);
     bool loop_init_2 = true;
     while(true) {
         if (all(loop_bound_2 == uint2(0u, 0u))) { break; }
         loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
         if (!loop_init_2) {
-            uint _e93 = j;
-            j = (_e93 + 1u);
+            uint _e137 = i;
+            i = (_e137 + 1u);
         }
         loop_init_2 = false;
-        uint _e63 = j;
-        if ((_e63 < 4u)) {
+        uint _e106 = i;
+        if ((_e106 < 4u)) {
         } else {
             break;
         }
         {
-            uint _e67 = j;
-            uint _e71 = j;
-            uint _e76 = j;
-            float4 v_7 = epipolar_samples.Load(int3(uint2((_e61.k[min(uint(naga_div(_e67, 2u)), 1u)] + naga_mod(_e71, 2u)), _e61.slices[min(uint(naga_div(_e76, 2u)), 1u)]), int(0)));
-            uint _e85 = j;
-            depths[min(uint(_e85), 3u)] = v_7.w;
-            uint _e89 = j;
-            light[min(uint(_e89), 3u)] = v_7.xyz;
+            uint _e109 = i;
+            uint _e112 = i;
+            uint2 q_2 = (q0_ + uint2(naga_mod(_e109, UNWARP_BLOCK), naga_div(_e112, UNWARP_BLOCK)));
+            if ((q_2.x < screen.x)) {
+                local_1 = (q_2.y < screen.y);
+            } else {
+                local_1 = false;
+            }
+            bool _e126 = local_1;
+            if (_e126) {
+                const float4 _e133 = epipolar_block_weightsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e67, ((float2(q_2) + float2(0.5, 0.5)) - centre));
+                float4 _e134 = depths;
+                float3 _e135[4] = light;
+                unwarp_pixel(q_2, _e133, _e104, _e134, _e135);
+            }
         }
     }
-    float4 _e96 = depths;
-    float3 _e97[4] = light;
-    unwarp_pixel(q_2, _e61.w, _e96, _e97);
     return;
 }

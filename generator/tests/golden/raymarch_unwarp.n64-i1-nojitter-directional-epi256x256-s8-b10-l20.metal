@@ -46,10 +46,18 @@ struct EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
 struct type_6 {
     metal::float3 inner[4];
 };
-struct EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
+struct EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
     metal::uint2 slices;
     metal::uint2 k;
-    metal::float4 w;
+    float fs;
+    char _pad3[4];
+    metal::float2 gs;
+    metal::float2 fk;
+    metal::float2 gk_lo;
+    metal::float2 gk_hi;
+    metal::float2 fs_range;
+    metal::float2 fk_min;
+    metal::float2 fk_max;
 };
 struct EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
     float t_close;
@@ -67,6 +75,7 @@ typedef uint type_12[1];
 constant uint SLICES = 256u;
 constant uint SLICE_SAMPLES = 256u;
 constant uint SLICE_LANES = 8u;
+constant uint UNWARP_BLOCK = 2u;
 constant uint STEP = 8u;
 constant uint SLICE_RUNS = 32u;
 constant float DEPTH_BREAK = 0.1;
@@ -86,8 +95,8 @@ metal::float3 raymarch_pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(
 ) {
     float ndc_x = ((2.0 * (static_cast<float>(x) + 0.5)) / static_cast<float>(m_1.sizes.x)) - 1.0;
     float ndc_y = 1.0 - ((2.0 * (static_cast<float>(y) + 0.5)) / static_cast<float>(m_1.sizes.y));
-    float t_4 = m_1.cam_forward.w;
-    return metal::normalize((m_1.cam_forward.xyz + (m_1.cam_right.xyz * ((ndc_x * t_4) * m_1.cam_right.w))) + (m_1.cam_up.xyz * (ndc_y * t_4)));
+    float t_2 = m_1.cam_forward.w;
+    return metal::normalize((m_1.cam_forward.xyz + (m_1.cam_right.xyz * ((ndc_x * t_2) * m_1.cam_right.w))) + (m_1.cam_up.xyz * (ndc_y * t_2)));
 }
 
 float pixel_jitterX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(
@@ -114,18 +123,19 @@ bool depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
     float b,
     float depth_break
 ) {
-    bool local_1 = {};
+    bool local_2 = {};
     if (!((a == b))) {
-        local_1 = metal::abs(a - b) <= (depth_break * metal::min(a, b));
+        local_2 = metal::abs(a - b) <= (depth_break * metal::min(a, b));
     } else {
-        local_1 = true;
+        local_2 = true;
     }
-    bool _e13 = local_1;
+    bool _e13 = local_2;
     return _e13;
 }
 
 metal::float4 lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
     metal::float4 w,
+    metal::float4 support,
     metal::float4 depths_1,
     type_6 light_1,
     float d,
@@ -139,16 +149,17 @@ metal::float4 lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
     uint taps = 0u;
     uint close = 0u;
     uint k = 0u;
-    bool local_2 = {};
     bool local_3 = {};
+    bool local_4 = {};
+    bool local_5 = {};
     uint2 loop_bound = uint2(4294967295u);
     bool loop_init = true;
     while(true) {
         if (metal::all(loop_bound == uint2(0u))) { break; }
         loop_bound -= uint2(loop_bound.y == 0u, 1u);
         if (!loop_init) {
-            uint _e63 = k;
-            k = _e63 + 1u;
+            uint _e72 = k;
+            k = _e72 + 1u;
         }
         loop_init = false;
         uint _e6 = k;
@@ -157,61 +168,70 @@ metal::float4 lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
             break;
         }
         {
-            uint _e10 = taps;
-            uint _e12 = k;
-            taps = _e10 + ((w[metal::min(unsigned(_e12), 3u)] > 0.0) ? 1u : 0u);
-            uint _e20 = k;
-            if (w[metal::min(unsigned(_e20), 3u)] > 0.0) {
-                uint _e25 = k;
-                bool _e29 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(depths_1[metal::min(unsigned(_e25), 3u)], d, depth_break_1);
-                local_2 = _e29;
+            uint _e10 = k;
+            bool _e14 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(depths_1[metal::min(unsigned(_e10), 3u)], d, depth_break_1);
+            uint _e16 = taps;
+            uint _e18 = k;
+            taps = _e16 + ((support[metal::min(unsigned(_e18), 3u)] > 0.0) ? 1u : 0u);
+            uint _e26 = k;
+            if (support[metal::min(unsigned(_e26), 3u)] > 0.0) {
+                local_3 = _e14;
             } else {
-                local_2 = false;
+                local_3 = false;
             }
-            bool _e33 = local_2;
+            bool _e33 = local_3;
             if (_e33) {
                 uint _e35 = close;
                 close = _e35 + 1u;
-                metal::float3 _e40 = sum;
+                metal::float3 _e40 = lo;
                 uint _e41 = k;
-                uint _e43 = k;
-                sum = _e40 + (w[metal::min(unsigned(_e41), 3u)] * light_1.inner[metal::min(unsigned(_e43), 3u)]);
-                float _e48 = total;
-                uint _e49 = k;
-                total = _e48 + w[metal::min(unsigned(_e49), 3u)];
-                metal::float3 _e53 = lo;
-                uint _e54 = k;
-                lo = metal::min(_e53, light_1.inner[metal::min(unsigned(_e54), 3u)]);
-                metal::float3 _e58 = hi;
-                uint _e59 = k;
-                hi = metal::max(_e58, light_1.inner[metal::min(unsigned(_e59), 3u)]);
+                lo = metal::min(_e40, light_1.inner[metal::min(unsigned(_e41), 3u)]);
+                metal::float3 _e45 = hi;
+                uint _e46 = k;
+                hi = metal::max(_e45, light_1.inner[metal::min(unsigned(_e46), 3u)]);
+            }
+            uint _e50 = k;
+            if (w[metal::min(unsigned(_e50), 3u)] > 0.0) {
+                local_4 = _e14;
+            } else {
+                local_4 = false;
+            }
+            bool _e57 = local_4;
+            if (_e57) {
+                metal::float3 _e59 = sum;
+                uint _e60 = k;
+                uint _e62 = k;
+                sum = _e59 + (w[metal::min(unsigned(_e60), 3u)] * light_1.inner[metal::min(unsigned(_e62), 3u)]);
+                float _e67 = total;
+                uint _e68 = k;
+                total = _e67 + w[metal::min(unsigned(_e68), 3u)];
             }
         }
     }
-    float _e65 = total;
-    if (!((_e65 <= 0.0))) {
-        uint _e69 = close;
-        uint _e70 = taps;
-        local_3 = _e69 < metal::min(_e70, 2u);
+    float _e74 = total;
+    if (!((_e74 <= 0.0))) {
+        uint _e78 = close;
+        uint _e79 = taps;
+        local_5 = _e78 < metal::min(_e79, 2u);
     } else {
-        local_3 = true;
+        local_5 = true;
     }
-    bool _e77 = local_3;
-    if (_e77) {
+    bool _e86 = local_5;
+    if (_e86) {
         return metal::float4(0.0, 0.0, 0.0, 0.0);
     }
-    metal::float3 _e83 = hi;
-    metal::float3 _e84 = lo;
-    metal::float3 spread = _e83 - _e84;
-    float _e93 = hi.x;
-    float _e95 = hi.y;
-    float _e97 = hi.z;
-    if (metal::max(spread.x, metal::max(spread.y, spread.z)) > (light_break * metal::max(_e93, metal::max(_e95, _e97)))) {
+    metal::float3 _e92 = hi;
+    metal::float3 _e93 = lo;
+    metal::float3 spread = _e92 - _e93;
+    float _e102 = hi.x;
+    float _e104 = hi.y;
+    float _e106 = hi.z;
+    if (metal::max(spread.x, metal::max(spread.y, spread.z)) > (light_break * metal::max(_e102, metal::max(_e104, _e106)))) {
         return metal::float4(0.0, 0.0, 0.0, 0.0);
     }
-    metal::float3 _e107 = sum;
-    float _e108 = total;
-    metal::float3 c = _e107 / metal::float3(_e108);
+    metal::float3 _e116 = sum;
+    float _e117 = total;
+    metal::float3 c = _e116 / metal::float3(_e117);
     return metal::float4(c.x, c.y, c.z, 1.0);
 }
 
@@ -234,84 +254,104 @@ uint naga_f2u32(float value) {
     return static_cast<uint>(metal::clamp(value, 0.0, 4294967000.0));
 }
 
-EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_slicesX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
+EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_block_slicesX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
     EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX l,
-    metal::uint2 p,
+    metal::float2 x_2,
     uint slices
 ) {
     uint s_lo = 0u;
-    float fs = 0.0;
-    EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX t = {};
-    metal::float2 d_2 = (static_cast<metal::float2>(p) + metal::float2(0.5, 0.5)) - l.origin;
-    float _e12 = epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l.axis, d_2);
-    float f = ((_e12 - l.phi_start) / l.dphi) - 0.5;
+    float base = 0.0;
+    EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX b_1 = {};
+    metal::float2 d_2 = x_2 - l.origin;
+    float _e7 = epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l.axis, d_2);
+    float f = ((_e7 - l.phi_start) / l.dphi) - 0.5;
     if (l.wrap != 0u) {
         float fl = metal::floor(f);
-        fs = f - fl;
+        base = fl;
         s_lo = naga_mod(static_cast<uint>(as_type<int>(as_type<uint>(naga_f2i32(fl)) + as_type<uint>(static_cast<int>(slices)))), slices);
     } else {
         float fc = metal::clamp(f, 0.0, static_cast<float>(slices - 1u));
         s_lo = metal::min(naga_f2u32(fc), slices - 2u);
-        uint _e41 = s_lo;
-        fs = fc - static_cast<float>(_e41);
+        uint _e35 = s_lo;
+        base = static_cast<float>(_e35);
     }
-    uint _e46 = s_lo;
-    uint _e47 = s_lo;
-    t.slices = metal::uint2(_e46, naga_mod(_e47 + 1u, slices));
-    float _e53 = fs;
-    float _e56 = fs;
-    t.w = metal::float4(1.0 - _e53, _e56, 0.0, 0.0);
-    EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e60 = t;
-    return _e60;
+    uint _e39 = s_lo;
+    uint _e40 = s_lo;
+    b_1.slices = metal::uint2(_e39, naga_mod(_e40 + 1u, slices));
+    float _e46 = base;
+    b_1.fs = f - _e46;
+    float _e49 = base;
+    float _e54 = base;
+    b_1.fs_range = (l.wrap != 0u) ? metal::float2(-340000000000000000000000000000000000000.0, 340000000000000000000000000000000000000.0) : metal::float2(-(_e49), static_cast<float>(slices - 1u) - _e54);
+    metal::float2 gs = metal::float2(-(d_2.y), d_2.x) / metal::float2(metal::max(metal::dot(d_2, d_2), 0.00000000000000000001) * l.dphi);
+    b_1.gs = as_type<metal::float2>(as_type<metal::uint2>(gs) & metal::uint2(4294963200u));
+    EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e81 = b_1;
+    return _e81;
 }
 
-EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
+metal::uint2 naga_f2u32(metal::float2 value) {
+    return static_cast<metal::uint2>(metal::clamp(value, 0.0, 4294967000.0));
+}
+
+EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_block_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
     EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX l_1,
-    metal::uint2 p_1,
-    EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX pair,
+    metal::float2 x_3,
+    EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX block,
     metal::float4 line_lo,
     metal::float4 line_hi,
     uint samples
 ) {
-    EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX t_1 = {};
-    uint j_1 = 0u;
-    metal::float2 d_3 = (static_cast<metal::float2>(p_1) + metal::float2(0.5, 0.5)) - l_1.origin;
-    t_1 = pair;
-    metal::float2 ws = pair.w.xy;
-    uint2 loop_bound_1 = uint2(4294967295u);
-    bool loop_init_1 = true;
-    while(true) {
-        if (metal::all(loop_bound_1 == uint2(0u))) { break; }
-        loop_bound_1 -= uint2(loop_bound_1.y == 0u, 1u);
-        if (!loop_init_1) {
-            uint _e68 = j_1;
-            j_1 = _e68 + 1u;
-        }
-        loop_init_1 = false;
-        uint _e15 = j_1;
-        if (_e15 < 2u) {
-        } else {
-            break;
-        }
-        {
-            uint _e18 = j_1;
-            metal::float4 line = (_e18 == 1u) ? line_hi : line_lo;
-            float g_1 = (metal::dot(d_3, line.xy) - line.z) / metal::max(line.w, 0.00000000000000000001);
-            float gc = metal::clamp(g_1, 0.0, static_cast<float>(samples - 1u));
-            uint k_lo = metal::min(naga_f2u32(gc), samples - 2u);
-            float fk = gc - static_cast<float>(k_lo);
-            uint _e45 = j_1;
-            t_1.k[metal::min(unsigned(_e45), 1u)] = k_lo;
-            uint _e49 = j_1;
-            uint _e52 = j_1;
-            t_1.w[metal::min(unsigned(2u * _e49), 3u)] = ws[metal::min(unsigned(_e52), 1u)] * (1.0 - fk);
-            uint _e59 = j_1;
-            uint _e64 = j_1;
-            t_1.w[metal::min(unsigned((2u * _e59) + 1u), 3u)] = ws[metal::min(unsigned(_e64), 1u)] * fk;
-        }
+    EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX b_2 = {};
+    metal::float2 d_3 = x_3 - l_1.origin;
+    b_2 = block;
+    float s0_ = metal::max(line_lo.w, 0.00000000000000000001);
+    float s1_ = metal::max(line_hi.w, 0.00000000000000000001);
+    metal::float2 g_1 = metal::float2((metal::dot(d_3, line_lo.xy) - line_lo.z) / s0_, (metal::dot(d_3, line_hi.xy) - line_hi.z) / s1_);
+    metal::float2 gc = metal::clamp(g_1, metal::float2(0.0, 0.0), metal::float2(static_cast<float>(samples - 1u)));
+    b_2.k = metal::min(naga_f2u32(gc), metal::uint2(samples - 2u));
+    metal::uint2 _e42 = b_2.k;
+    b_2.fk = g_1 - static_cast<metal::float2>(_e42);
+    metal::uint2 _e47 = b_2.k;
+    b_2.fk_min = -(static_cast<metal::float2>(_e47));
+    metal::uint2 _e56 = b_2.k;
+    b_2.fk_max = metal::float2(static_cast<float>(samples - 1u)) - static_cast<metal::float2>(_e56);
+    b_2.gk_lo = line_lo.xy / metal::float2(s0_);
+    b_2.gk_hi = line_hi.xy / metal::float2(s1_);
+    EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e67 = b_2;
+    return _e67;
+}
+
+metal::float4 epipolar_block_weightsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
+    EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX b_3,
+    metal::float2 o
+) {
+    bool local_6 = {};
+    bool local_7 = {};
+    bool local_8 = {};
+    float own_s = metal::clamp(b_3.fs + metal::dot(b_3.gs, o), b_3.fs_range.x, b_3.fs_range.y);
+    metal::float2 own_k = metal::clamp(b_3.fk + metal::float2(metal::dot(b_3.gk_lo, o), metal::dot(b_3.gk_hi, o)), b_3.fk_min, b_3.fk_max);
+    if (!((own_s < -0.5))) {
+        local_6 = own_s > 1.5;
+    } else {
+        local_6 = true;
     }
-    EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e70 = t_1;
-    return _e70;
+    bool _e29 = local_6;
+    if (!(_e29)) {
+        local_7 = metal::any(own_k < metal::float2(-0.5, -0.5));
+    } else {
+        local_7 = true;
+    }
+    bool _e39 = local_7;
+    if (!(_e39)) {
+        local_8 = metal::any(own_k > metal::float2(1.5, 1.5));
+    } else {
+        local_8 = true;
+    }
+    bool beyond = local_8;
+    float fs = metal::clamp(own_s, 0.0, 1.0);
+    metal::float2 fk = metal::clamp(own_k, metal::float2(0.0, 0.0), metal::float2(1.0, 1.0));
+    metal::float4 w_3 = metal::float4((1.0 - fs) * (1.0 - fk.x), (1.0 - fs) * fk.x, fs * (1.0 - fk.y), fs * fk.y);
+    return beyond ? metal::float4(0.0, 0.0, 0.0, 0.0) : w_3;
 }
 
 float phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
@@ -326,19 +366,19 @@ float transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     float sigma_t,
     float len
 ) {
-    float x_4 = sigma_t * len;
-    if (x_4 < 0.0001) {
-        return len * (1.0 - (0.5 * x_4));
+    float x_6 = sigma_t * len;
+    if (x_6 < 0.0001) {
+        return len * (1.0 - (0.5 * x_6));
     }
-    return (1.0 - metal::exp(-(x_4))) / sigma_t;
+    return (1.0 - metal::exp(-(x_6))) / sigma_t;
 }
 
 float transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     float sigma_t_1,
     float a_1,
-    float b_1
+    float b_4
 ) {
-    float _e7 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1, b_1 - a_1);
+    float _e7 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1, b_4 - a_1);
     return metal::exp(-(sigma_t_1) * a_1) * _e7;
 }
 
@@ -347,28 +387,28 @@ float cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     float cos_inner,
     float cos_outer
 ) {
-    float x_5 = metal::clamp((cos_angle - cos_outer) / (cos_inner - cos_outer), 0.0, 1.0);
-    return ((cos_inner - cos_outer) <= 0.000001) ? ((cos_angle >= cos_outer) ? 1.0 : 0.0) : ((x_5 * x_5) * (3.0 - (2.0 * x_5)));
+    float x_7 = metal::clamp((cos_angle - cos_outer) / (cos_inner - cos_outer), 0.0, 1.0);
+    return ((cos_inner - cos_outer) <= 0.000001) ? ((cos_angle >= cos_outer) ? 1.0 : 0.0) : ((x_7 * x_7) * (3.0 - (2.0 * x_7)));
 }
 
 float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     metal::float3 eye,
     metal::float3 dir,
-    float t_2,
+    float t,
     metal::float3 light_pos,
     metal::float3 light_dir,
     float cos_inner_1,
     float cos_outer_1,
     metal::float4 medium
 ) {
-    metal::float3 x_6 = eye + (dir * t_2);
-    metal::float3 to_x = x_6 - light_pos;
+    metal::float3 x_8 = eye + (dir * t);
+    metal::float3 to_x = x_8 - light_pos;
     float d2_ = metal::max(metal::dot(to_x, to_x), 0.000000000001);
     float d_4 = metal::sqrt(d2_);
     metal::float3 travel = to_x / metal::float3(d_4);
     float _e17 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(metal::dot(travel, light_dir), cos_inner_1, cos_outer_1);
     float _e22 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(medium.z, -(metal::dot(travel, dir)));
-    return (((medium.y * _e22) * _e17) * metal::exp(-(medium.x) * (d_4 + t_2))) / d2_;
+    return (((medium.y * _e22) * _e17) * metal::exp(-(medium.x) * (d_4 + t))) / d2_;
 }
 
 EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
@@ -376,28 +416,28 @@ EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX equiangularX_naga_oil_mod_XO
     metal::float3 dir_1,
     metal::float3 light_pos_1,
     float a_2,
-    float b_2,
+    float b_5,
     uint n
 ) {
     float t0_ = metal::dot(light_pos_1 - eye_1, dir_1);
-    float h_1 = metal::max(metal::length((eye_1 + (dir_1 * t0_)) - light_pos_1), 0.0001 * metal::max(b_2 - a_2, 0.000001));
+    float h_1 = metal::max(metal::length((eye_1 + (dir_1 * t0_)) - light_pos_1), 0.0001 * metal::max(b_5 - a_2, 0.000001));
     float theta_a = metal::atan((a_2 - t0_) / h_1);
-    return EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {t0_, h_1, theta_a, (metal::atan((b_2 - t0_) / h_1) - theta_a) / static_cast<float>(n)};
+    return EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {t0_, h_1, theta_a, (metal::atan((b_5 - t0_) / h_1) - theta_a) / static_cast<float>(n)};
 }
 
 metal::float2 equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX e,
-    float x_2
+    float x_4
 ) {
-    float tau = metal::tan(e.theta_a + (x_2 * e.dtheta));
+    float tau = metal::tan(e.theta_a + (x_4 * e.dtheta));
     return metal::float2(e.t_close + (e.dist * tau), (e.dtheta * e.dist) * (1.0 + (tau * tau)));
 }
 
 metal::float3 shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
     ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v,
-    metal::float3 p_2
+    metal::float3 p
 ) {
-    metal::float3 q_1 = p_2 - v.origin.xyz;
+    metal::float3 q_1 = p - v.origin.xyz;
     return metal::float3(metal::dot(q_1, v.right.xyz), metal::dot(q_1, v.up.xyz), metal::dot(q_1, v.forward.xyz));
 }
 
@@ -406,8 +446,8 @@ metal::float2 shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
     metal::float3 ls
 ) {
     float z_1 = metal::max(ls.z, 0.000001);
-    float t_5 = v_1.proj.x;
-    return metal::float2(0.5 + ((0.5 * ls.x) / (z_1 * t_5)), 0.5 - ((0.5 * ls.y) / (z_1 * t_5)));
+    float t_3 = v_1.proj.x;
+    return metal::float2(0.5 + ((0.5 * ls.x) / (z_1 * t_3)), 0.5 - ((0.5 * ls.y) / (z_1 * t_3)));
 }
 
 float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
@@ -417,10 +457,10 @@ float shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
 ) {
     bool outside = (((uv.x < 0.0) | (uv.x > 1.0)) | (uv.y < 0.0)) | (uv.y > 1.0);
     uint n_1 = v_2.size.x;
-    uint x_7 = metal::min(naga_f2u32(uv.x * static_cast<float>(n_1)), n_1 - 1u);
+    uint x_9 = metal::min(naga_f2u32(uv.x * static_cast<float>(n_1)), n_1 - 1u);
     uint y_3 = metal::min(naga_f2u32(uv.y * static_cast<float>(n_1)), n_1 - 1u);
     uint clamped_lod_e36 = metal::min(uint(0), sm.get_num_mip_levels() - 1);
-    metal::float4 _e36 = sm.read(metal::min(metal::uint2(metal::uint2(x_7, y_3)), metal::uint2(sm.get_width(clamped_lod_e36), sm.get_height(clamped_lod_e36)) - 1), clamped_lod_e36);
+    metal::float4 _e36 = sm.read(metal::min(metal::uint2(metal::uint2(x_9, y_3)), metal::uint2(sm.get_width(clamped_lod_e36), sm.get_height(clamped_lod_e36)) - 1), clamped_lod_e36);
     return outside ? 2.0 : _e36.x;
 }
 
@@ -449,10 +489,10 @@ float shadow_bias_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
 float shadow_visibility_forX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(
     ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX v_6,
     metal::texture2d<float, metal::access::sample> sm_1,
-    metal::float3 p_3,
+    metal::float3 p_1,
     bool perspective
 ) {
-    metal::float3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, p_3);
+    metal::float3 _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, p_1);
     float near = v_6.right.w;
     float far = v_6.up.w;
     if (perspective) {
@@ -487,6 +527,7 @@ uint naga_div(uint lhs, uint rhs) {
 void unwarp_pixel(
     metal::uint2 q,
     metal::float4 w_1,
+    metal::float4 support_1,
     metal::float4 depths_2,
     type_6 light_2,
     metal::texture2d<float, metal::access::sample> depth,
@@ -497,90 +538,90 @@ void unwarp_pixel(
 ) {
     uint clamped_lod_e3 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
     metal::float4 _e3 = depth.read(metal::min(metal::uint2(q), metal::uint2(depth.get_width(clamped_lod_e3), depth.get_height(clamped_lod_e3)) - 1), clamped_lod_e3);
-    metal::float4 _e10 = lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(w_1, depths_2, light_2, _e3.x, DEPTH_BREAK, LIGHT_BREAK);
-    if (_e10.w == 0.0) {
-        uint _e17 = metal::atomic_fetch_add_explicit(&fallback_count.listed, 1u, metal::memory_order_relaxed);
-        fallback_pixels[metal::min(unsigned(_e17), (_buffer_sizes.size6 - 0 - 4) / 4)] = q.x | (q.y << 16u);
-        if (naga_mod(_e17, 64u) == 0u) {
-            uint g_2 = naga_div(_e17, 64u) + 1u;
-            uint _e37 = metal::atomic_fetch_max_explicit(&fallback_count.groups_x, metal::min(g_2, FALLBACK_ROW_GROUPS), metal::memory_order_relaxed);
-            uint _e46 = metal::atomic_fetch_max_explicit(&fallback_count.groups_y, naga_div((g_2 + FALLBACK_ROW_GROUPS) - 1u, FALLBACK_ROW_GROUPS), metal::memory_order_relaxed);
+    metal::float4 _e11 = lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(w_1, support_1, depths_2, light_2, _e3.x, DEPTH_BREAK, LIGHT_BREAK);
+    if (_e11.w == 0.0) {
+        uint _e18 = metal::atomic_fetch_add_explicit(&fallback_count.listed, 1u, metal::memory_order_relaxed);
+        fallback_pixels[metal::min(unsigned(_e18), (_buffer_sizes.size6 - 0 - 4) / 4)] = q.x | (q.y << 16u);
+        if (naga_mod(_e18, 64u) == 0u) {
+            uint g_2 = naga_div(_e18, 64u) + 1u;
+            uint _e38 = metal::atomic_fetch_max_explicit(&fallback_count.groups_x, metal::min(g_2, FALLBACK_ROW_GROUPS), metal::memory_order_relaxed);
+            uint _e47 = metal::atomic_fetch_max_explicit(&fallback_count.groups_y, naga_div((g_2 + FALLBACK_ROW_GROUPS) - 1u, FALLBACK_ROW_GROUPS), metal::memory_order_relaxed);
             return;
         } else {
             return;
         }
     } else {
-        output.write(_e10, metal::uint2(q));
+        output.write(_e11, metal::uint2(q));
         return;
     }
 }
 
 metal::float3 raymarch_pixel(
-    uint x_3,
+    uint x_5,
     uint y_2,
     constant RaymarchFrameX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX& frame,
     metal::texture2d<float, metal::access::sample> depth,
     metal::texture2d<float, metal::access::sample> shadow_map
 ) {
     float sum_1 = 0.0;
-    uint j_2 = {};
-    float t_3 = {};
+    uint j_1 = {};
+    float t_1 = {};
     float w_2 = {};
     float l_2 = {};
     RaymarchFrameX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX m_2 = frame;
     metal::float3 eye_2 = m_2.eye.xyz;
-    metal::float3 _e7 = raymarch_pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m_2, x_3, y_2);
+    metal::float3 _e7 = raymarch_pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m_2, x_5, y_2);
     uint clamped_lod_e11 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
-    metal::float4 _e11 = depth.read(metal::min(metal::uint2(metal::uint2(x_3, y_2)), metal::uint2(depth.get_width(clamped_lod_e11), depth.get_height(clamped_lod_e11)) - 1), clamped_lod_e11);
+    metal::float4 _e11 = depth.read(metal::min(metal::uint2(metal::uint2(x_5, y_2)), metal::uint2(depth.get_width(clamped_lod_e11), depth.get_height(clamped_lod_e11)) - 1), clamped_lod_e11);
     float s = metal::min(metal::max(_e11.x, 0.0), m_2.eye.w) / metal::max(metal::dot(_e7, m_2.cam_forward.xyz), 0.000001);
     uint n_2 = m_2.sizes.w;
     float h_2 = s / static_cast<float>(n_2);
     uint mx = m_2.interleave.x;
     uint my = m_2.interleave.y;
     uint stride = mx * my;
-    uint pixel_class = naga_mod(x_3, mx) + (mx * naga_mod(y_2, my));
-    float _e37 = pixel_jitterX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(x_3, y_2);
+    uint pixel_class = naga_mod(x_5, mx) + (mx * naga_mod(y_2, my));
+    float _e37 = pixel_jitterX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(x_5, y_2);
     float u = (m_2.interleave.z != 0u) ? _e37 : 0.5;
     ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX _e44 = raymarch_shadow_viewX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m_2);
     EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX _e48 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2, _e7, m_2.light_pos.xyz, 0.0, s, n_2);
-    j_2 = pixel_class;
-    uint2 loop_bound_2 = uint2(4294967295u);
-    bool loop_init_2 = true;
+    j_1 = pixel_class;
+    uint2 loop_bound_1 = uint2(4294967295u);
+    bool loop_init_1 = true;
     while(true) {
-        if (metal::all(loop_bound_2 == uint2(0u))) { break; }
-        loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
-        if (!loop_init_2) {
-            uint _e101 = j_2;
-            j_2 = _e101 + stride;
+        if (metal::all(loop_bound_1 == uint2(0u))) { break; }
+        loop_bound_1 -= uint2(loop_bound_1.y == 0u, 1u);
+        if (!loop_init_1) {
+            uint _e101 = j_1;
+            j_1 = _e101 + stride;
         }
-        loop_init_2 = false;
-        uint _e50 = j_2;
+        loop_init_1 = false;
+        uint _e50 = j_1;
         if (_e50 < n_2) {
         } else {
             break;
         }
         {
-            uint _e52 = j_2;
-            t_3 = (static_cast<float>(_e52) + u) * h_2;
+            uint _e52 = j_1;
+            t_1 = (static_cast<float>(_e52) + u) * h_2;
             w_2 = h_2;
             if (false) {
-                uint _e59 = j_2;
+                uint _e59 = j_1;
                 metal::float2 _e62 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e48, static_cast<float>(_e59) + u);
-                t_3 = _e62.x;
+                t_1 = _e62.x;
                 w_2 = _e62.y;
             }
-            float _e65 = t_3;
+            float _e65 = t_1;
             float _e69 = shadow_visibility_forX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e44, shadow_map, eye_2 + (_e7 * _e65), false);
             if (false) {
                 float _e71 = sum_1;
                 float _e72 = w_2;
-                float _e74 = t_3;
+                float _e74 = t_1;
                 float _e84 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2, _e7, _e74, m_2.light_pos.xyz, m_2.light_dir.xyz, m_2.light_pos.w, m_2.light_dir.w, m_2.medium);
                 sum_1 = _e71 + ((_e69 * _e72) * _e84);
             } else {
                 float _e87 = sum_1;
-                uint _e90 = j_2;
-                uint _e93 = j_2;
+                uint _e90 = j_1;
+                uint _e93 = j_1;
                 float _e98 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(m_2.medium.x, static_cast<float>(_e90) * h_2, static_cast<float>(_e93 + 1u) * h_2);
                 sum_1 = _e87 + (_e69 * _e98);
             }
@@ -614,59 +655,93 @@ kernel void raymarch_unwarp(
     metal::float4 depths = metal::float4(0.0, 0.0, 0.0, 0.0);
     type_6 light = {};
     uint j = 0u;
+    uint i = 0u;
+    bool local_1 = {};
     uint _e6 = frame.sizes.x;
     uint _e10 = frame.sizes.y;
     metal::uint2 screen = metal::uint2(_e6, _e10);
-    metal::uint2 q_2 = id.xy;
-    if (!((q_2.x >= screen.x))) {
-        local = q_2.y >= screen.y;
+    metal::uint2 q0_ = id.xy * UNWARP_BLOCK;
+    if (!((q0_.x >= screen.x))) {
+        local = q0_.y >= screen.y;
     } else {
         local = true;
     }
-    bool _e24 = local;
-    if (_e24) {
+    bool _e26 = local;
+    if (_e26) {
         return;
     }
-    uint clamped_lod_e30 = metal::min(uint(0), epipolar_samples.get_num_mip_levels() - 1);
-    metal::float4 head = epipolar_samples.read(metal::min(metal::uint2(metal::uint2(0u, 256u)), metal::uint2(epipolar_samples.get_width(clamped_lod_e30), epipolar_samples.get_height(clamped_lod_e30)) - 1), clamped_lod_e30);
-    uint clamped_lod_e36 = metal::min(uint(0), epipolar_samples.get_num_mip_levels() - 1);
-    metal::float4 angles = epipolar_samples.read(metal::min(metal::uint2(metal::uint2(1u, 256u)), metal::uint2(epipolar_samples.get_width(clamped_lod_e36), epipolar_samples.get_height(clamped_lod_e36)) - 1), clamped_lod_e36);
+    uint clamped_lod_e32 = metal::min(uint(0), epipolar_samples.get_num_mip_levels() - 1);
+    metal::float4 head = epipolar_samples.read(metal::min(metal::uint2(metal::uint2(0u, 256u)), metal::uint2(epipolar_samples.get_width(clamped_lod_e32), epipolar_samples.get_height(clamped_lod_e32)) - 1), clamped_lod_e32);
+    uint clamped_lod_e38 = metal::min(uint(0), epipolar_samples.get_num_mip_levels() - 1);
+    metal::float4 angles = epipolar_samples.read(metal::min(metal::uint2(metal::uint2(1u, 256u)), metal::uint2(epipolar_samples.get_width(clamped_lod_e38), epipolar_samples.get_height(clamped_lod_e38)) - 1), clamped_lod_e38);
     EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX lines = EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {head.xy, head.zw, angles.x, angles.y, naga_f2u32(angles.z)};
-    EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e45 = epipolar_slicesX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, q_2, SLICES);
-    uint clamped_lod_e52 = metal::min(uint(0), epipolar_samples.get_num_mip_levels() - 1);
-    metal::float4 line_lo_1 = epipolar_samples.read(metal::min(metal::uint2(metal::uint2(SLICE_SAMPLES, _e45.slices.x)), metal::uint2(epipolar_samples.get_width(clamped_lod_e52), epipolar_samples.get_height(clamped_lod_e52)) - 1), clamped_lod_e52);
-    uint clamped_lod_e59 = metal::min(uint(0), epipolar_samples.get_num_mip_levels() - 1);
-    metal::float4 line_hi_1 = epipolar_samples.read(metal::min(metal::uint2(metal::uint2(SLICE_SAMPLES, _e45.slices.y)), metal::uint2(epipolar_samples.get_width(clamped_lod_e59), epipolar_samples.get_height(clamped_lod_e59)) - 1), clamped_lod_e59);
-    EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e61 = epipolar_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, q_2, _e45, line_lo_1, line_hi_1, SLICE_SAMPLES);
+    metal::float2 centre = static_cast<metal::float2>(q0_) + metal::float2(1.0);
+    EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e51 = epipolar_block_slicesX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, centre, SLICES);
+    uint clamped_lod_e58 = metal::min(uint(0), epipolar_samples.get_num_mip_levels() - 1);
+    metal::float4 line_lo_1 = epipolar_samples.read(metal::min(metal::uint2(metal::uint2(SLICE_SAMPLES, _e51.slices.x)), metal::uint2(epipolar_samples.get_width(clamped_lod_e58), epipolar_samples.get_height(clamped_lod_e58)) - 1), clamped_lod_e58);
+    uint clamped_lod_e65 = metal::min(uint(0), epipolar_samples.get_num_mip_levels() - 1);
+    metal::float4 line_hi_1 = epipolar_samples.read(metal::min(metal::uint2(metal::uint2(SLICE_SAMPLES, _e51.slices.y)), metal::uint2(epipolar_samples.get_width(clamped_lod_e65), epipolar_samples.get_height(clamped_lod_e65)) - 1), clamped_lod_e65);
+    EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e67 = epipolar_block_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, centre, _e51, line_lo_1, line_hi_1, SLICE_SAMPLES);
+    uint2 loop_bound_2 = uint2(4294967295u);
+    bool loop_init_2 = true;
+    while(true) {
+        if (metal::all(loop_bound_2 == uint2(0u))) { break; }
+        loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
+        if (!loop_init_2) {
+            uint _e99 = j;
+            j = _e99 + 1u;
+        }
+        loop_init_2 = false;
+        uint _e69 = j;
+        if (_e69 < 4u) {
+        } else {
+            break;
+        }
+        {
+            uint _e73 = j;
+            uint _e77 = j;
+            uint _e82 = j;
+            uint clamped_lod_e89 = metal::min(uint(0), epipolar_samples.get_num_mip_levels() - 1);
+            metal::float4 v_7 = epipolar_samples.read(metal::min(metal::uint2(metal::uint2(_e67.k[metal::min(unsigned(naga_div(_e73, 2u)), 1u)] + naga_mod(_e77, 2u), _e67.slices[metal::min(unsigned(naga_div(_e82, 2u)), 1u)])), metal::uint2(epipolar_samples.get_width(clamped_lod_e89), epipolar_samples.get_height(clamped_lod_e89)) - 1), clamped_lod_e89);
+            uint _e91 = j;
+            depths[metal::min(unsigned(_e91), 3u)] = v_7.w;
+            uint _e95 = j;
+            light.inner[metal::min(unsigned(_e95), 3u)] = v_7.xyz;
+        }
+    }
+    metal::float4 _e104 = epipolar_block_weightsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e67, metal::float2(0.0, 0.0));
     uint2 loop_bound_3 = uint2(4294967295u);
     bool loop_init_3 = true;
     while(true) {
         if (metal::all(loop_bound_3 == uint2(0u))) { break; }
         loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
         if (!loop_init_3) {
-            uint _e93 = j;
-            j = _e93 + 1u;
+            uint _e137 = i;
+            i = _e137 + 1u;
         }
         loop_init_3 = false;
-        uint _e63 = j;
-        if (_e63 < 4u) {
+        uint _e106 = i;
+        if (_e106 < 4u) {
         } else {
             break;
         }
         {
-            uint _e67 = j;
-            uint _e71 = j;
-            uint _e76 = j;
-            uint clamped_lod_e83 = metal::min(uint(0), epipolar_samples.get_num_mip_levels() - 1);
-            metal::float4 v_7 = epipolar_samples.read(metal::min(metal::uint2(metal::uint2(_e61.k[metal::min(unsigned(naga_div(_e67, 2u)), 1u)] + naga_mod(_e71, 2u), _e61.slices[metal::min(unsigned(naga_div(_e76, 2u)), 1u)])), metal::uint2(epipolar_samples.get_width(clamped_lod_e83), epipolar_samples.get_height(clamped_lod_e83)) - 1), clamped_lod_e83);
-            uint _e85 = j;
-            depths[metal::min(unsigned(_e85), 3u)] = v_7.w;
-            uint _e89 = j;
-            light.inner[metal::min(unsigned(_e89), 3u)] = v_7.xyz;
+            uint _e109 = i;
+            uint _e112 = i;
+            metal::uint2 q_2 = q0_ + metal::uint2(naga_mod(_e109, UNWARP_BLOCK), naga_div(_e112, UNWARP_BLOCK));
+            if (q_2.x < screen.x) {
+                local_1 = q_2.y < screen.y;
+            } else {
+                local_1 = false;
+            }
+            bool _e126 = local_1;
+            if (_e126) {
+                metal::float4 _e133 = epipolar_block_weightsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e67, (static_cast<metal::float2>(q_2) + metal::float2(0.5, 0.5)) - centre);
+                metal::float4 _e134 = depths;
+                type_6 _e135 = light;
+                unwarp_pixel(q_2, _e133, _e104, _e134, _e135, depth, output, fallback_count, fallback_pixels, _buffer_sizes);
+            }
         }
     }
-    metal::float4 _e96 = depths;
-    type_6 _e97 = light;
-    unwarp_pixel(q_2, _e61.w, _e96, _e97, depth, output, fallback_count, fallback_pixels, _buffer_sizes);
     return;
 }

@@ -35,10 +35,17 @@ struct EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
     wrap: u32,
 }
 
-struct EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
+struct EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
     slices: vec2<u32>,
     k: vec2<u32>,
-    w: vec4<f32>,
+    fs: f32,
+    gs: vec2<f32>,
+    fk: vec2<f32>,
+    gk_lo: vec2<f32>,
+    gk_hi: vec2<f32>,
+    fs_range: vec2<f32>,
+    fk_min: vec2<f32>,
+    fk_max: vec2<f32>,
 }
 
 struct EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
@@ -58,6 +65,7 @@ struct FallbackCount {
 const SLICES: u32 = 256u;
 const SLICE_SAMPLES: u32 = 256u;
 const SLICE_LANES: u32 = 8u;
+const UNWARP_BLOCK: u32 = 2u;
 const STEP: u32 = 8u;
 const SLICE_RUNS: u32 = 32u;
 const DEPTH_BREAK: f32 = 0.1f;
@@ -86,8 +94,8 @@ fn raymarch_shadow_viewX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m: Raymarch
 fn raymarch_pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m_1: RaymarchFrameX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX, x: u32, y: u32) -> vec3<f32> {
     let ndc_x = (((2f * (f32(x) + 0.5f)) / f32(m_1.sizes.x)) - 1f);
     let ndc_y = (1f - ((2f * (f32(y) + 0.5f)) / f32(m_1.sizes.y)));
-    let t_4 = m_1.cam_forward.w;
-    return normalize(((m_1.cam_forward.xyz + (m_1.cam_right.xyz * ((ndc_x * t_4) * m_1.cam_right.w))) + (m_1.cam_up.xyz * (ndc_y * t_4))));
+    let t_2 = m_1.cam_forward.w;
+    return normalize(((m_1.cam_forward.xyz + (m_1.cam_right.xyz * ((ndc_x * t_2) * m_1.cam_right.w))) + (m_1.cam_up.xyz * (ndc_y * t_2))));
 }
 
 fn pixel_jitterX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(x_1: u32, y_1: u32) -> f32 {
@@ -108,18 +116,18 @@ fn pixel_jitterX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(x_1: u32, y_1: u32)
 }
 
 fn depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(a: f32, b: f32, depth_break: f32) -> bool {
-    var local_1: bool;
+    var local_2: bool;
 
     if !((a == b)) {
-        local_1 = (abs((a - b)) <= (depth_break * min(a, b)));
+        local_2 = (abs((a - b)) <= (depth_break * min(a, b)));
     } else {
-        local_1 = true;
+        local_2 = true;
     }
-    let _e13 = local_1;
+    let _e13 = local_2;
     return _e13;
 }
 
-fn lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(w: vec4<f32>, depths_1: vec4<f32>, light_1: array<vec3<f32>, 4>, d: f32, depth_break_1: f32, light_break: f32) -> vec4<f32> {
+fn lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(w: vec4<f32>, support: vec4<f32>, depths_1: vec4<f32>, light_1: array<vec3<f32>, 4>, d: f32, depth_break_1: f32, light_break: f32) -> vec4<f32> {
     var sum: vec3<f32> = vec3<f32>(0f, 0f, 0f);
     var total: f32 = 0f;
     var lo: vec3<f32> = vec3<f32>(340000000000000000000000000000000000000f, 340000000000000000000000000000000000000f, 340000000000000000000000000000000000000f);
@@ -127,8 +135,9 @@ fn lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(w: vec4<f32>, depth
     var taps: u32 = 0u;
     var close: u32 = 0u;
     var k: u32 = 0u;
-    var local_2: bool;
     var local_3: bool;
+    var local_4: bool;
+    var local_5: bool;
 
     loop {
         let _e6 = k;
@@ -137,65 +146,74 @@ fn lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(w: vec4<f32>, depth
             break;
         }
         {
-            let _e10 = taps;
-            let _e12 = k;
-            taps = (_e10 + select(0u, 1u, (w[_e12] > 0f)));
-            let _e20 = k;
-            if (w[_e20] > 0f) {
-                let _e25 = k;
-                let _e29 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(depths_1[_e25], d, depth_break_1);
-                local_2 = _e29;
+            let _e10 = k;
+            let _e14 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(depths_1[_e10], d, depth_break_1);
+            let _e16 = taps;
+            let _e18 = k;
+            taps = (_e16 + select(0u, 1u, (support[_e18] > 0f)));
+            let _e26 = k;
+            if (support[_e26] > 0f) {
+                local_3 = _e14;
             } else {
-                local_2 = false;
+                local_3 = false;
             }
-            let _e33 = local_2;
+            let _e33 = local_3;
             if _e33 {
                 let _e35 = close;
                 close = (_e35 + 1u);
-                let _e40 = sum;
+                let _e40 = lo;
                 let _e41 = k;
-                let _e43 = k;
-                sum = (_e40 + (w[_e41] * light_1[_e43]));
-                let _e48 = total;
-                let _e49 = k;
-                total = (_e48 + w[_e49]);
-                let _e53 = lo;
-                let _e54 = k;
-                lo = min(_e53, light_1[_e54]);
-                let _e58 = hi;
-                let _e59 = k;
-                hi = max(_e58, light_1[_e59]);
+                lo = min(_e40, light_1[_e41]);
+                let _e45 = hi;
+                let _e46 = k;
+                hi = max(_e45, light_1[_e46]);
+            }
+            let _e50 = k;
+            if (w[_e50] > 0f) {
+                local_4 = _e14;
+            } else {
+                local_4 = false;
+            }
+            let _e57 = local_4;
+            if _e57 {
+                let _e59 = sum;
+                let _e60 = k;
+                let _e62 = k;
+                sum = (_e59 + (w[_e60] * light_1[_e62]));
+                let _e67 = total;
+                let _e68 = k;
+                total = (_e67 + w[_e68]);
             }
         }
         continuing {
-            let _e63 = k;
-            k = (_e63 + 1u);
+            let _e72 = k;
+            k = (_e72 + 1u);
         }
     }
-    let _e65 = total;
-    if !((_e65 <= 0f)) {
-        let _e69 = close;
-        let _e70 = taps;
-        local_3 = (_e69 < min(_e70, 2u));
+    let _e74 = total;
+    if !((_e74 <= 0f)) {
+        let _e78 = close;
+        let _e79 = taps;
+        local_5 = (_e78 < min(_e79, 2u));
     } else {
-        local_3 = true;
+        local_5 = true;
     }
-    let _e77 = local_3;
-    if _e77 {
+    let _e86 = local_5;
+    if _e86 {
         return vec4<f32>(0f, 0f, 0f, 0f);
     }
-    let _e83 = hi;
-    let _e84 = lo;
-    let spread = (_e83 - _e84);
-    let _e93 = hi.x;
-    let _e95 = hi.y;
-    let _e97 = hi.z;
-    if (max(spread.x, max(spread.y, spread.z)) > (light_break * max(_e93, max(_e95, _e97)))) {
+    let _e92 = hi;
+    let _e93 = lo;
+    let spread = (_e92 - _e93);
+    let _e102 = hi.x;
+    let _e104 = hi.y;
+    let _e106 = hi.z;
+    if (max(spread.x, max(spread.y, spread.z)) > (light_break * max(_e102, max(_e104, _e106)))) {
         return vec4<f32>(0f, 0f, 0f, 0f);
     }
-    let _e107 = sum;
-    let _e108 = total;
-    let c = (_e107 / vec3(_e108));
+    let _e116 = sum;
+    let _e117 = total;
+    let c = (_e116 / vec3(_e117));
     return vec4<f32>(c.x, c.y, c.z, 1f);
 }
 
@@ -203,70 +221,89 @@ fn epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(axis: vec2<f32>, 
     return atan2(((axis.x * d_1.y) - (axis.y * d_1.x)), ((axis.x * d_1.x) + (axis.y * d_1.y)));
 }
 
-fn epipolar_slicesX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l: EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX, p: vec2<u32>, slices: u32) -> EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
+fn epipolar_block_slicesX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l: EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX, x_2: vec2<f32>, slices: u32) -> EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
     var s_lo: u32 = 0u;
-    var fs: f32 = 0f;
-    var t: EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX;
+    var base: f32 = 0f;
+    var b_1: EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX;
 
-    let d_2 = ((vec2<f32>(p) + vec2<f32>(0.5f, 0.5f)) - l.origin);
-    let _e12 = epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l.axis, d_2);
-    let f = (((_e12 - l.phi_start) / l.dphi) - 0.5f);
+    let d_2 = (x_2 - l.origin);
+    let _e7 = epipolar_angleX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l.axis, d_2);
+    let f = (((_e7 - l.phi_start) / l.dphi) - 0.5f);
     if (l.wrap != 0u) {
         let fl = floor(f);
-        fs = (f - fl);
+        base = fl;
         s_lo = (u32((i32(fl) + i32(slices))) % slices);
     } else {
         let fc = clamp(f, 0f, f32((slices - 1u)));
         s_lo = min(u32(fc), (slices - 2u));
-        let _e41 = s_lo;
-        fs = (fc - f32(_e41));
+        let _e35 = s_lo;
+        base = f32(_e35);
     }
-    let _e46 = s_lo;
-    let _e47 = s_lo;
-    t.slices = vec2<u32>(_e46, ((_e47 + 1u) % slices));
-    let _e53 = fs;
-    let _e56 = fs;
-    t.w = vec4<f32>((1f - _e53), _e56, 0f, 0f);
-    let _e60 = t;
-    return _e60;
+    let _e39 = s_lo;
+    let _e40 = s_lo;
+    b_1.slices = vec2<u32>(_e39, ((_e40 + 1u) % slices));
+    let _e46 = base;
+    b_1.fs = (f - _e46);
+    let _e49 = base;
+    let _e54 = base;
+    b_1.fs_range = select(vec2<f32>(-(_e49), (f32((slices - 1u)) - _e54)), vec2<f32>(-340000000000000000000000000000000000000f, 340000000000000000000000000000000000000f), (l.wrap != 0u));
+    let gs = (vec2<f32>(-(d_2.y), d_2.x) / vec2((max(dot(d_2, d_2), 0.00000000000000000001f) * l.dphi)));
+    b_1.gs = bitcast<vec2<f32>>((bitcast<vec2<u32>>(gs) & vec2(4294963200u)));
+    let _e81 = b_1;
+    return _e81;
 }
 
-fn epipolar_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_1: EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX, p_1: vec2<u32>, pair: EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX, line_lo: vec4<f32>, line_hi: vec4<f32>, samples: u32) -> EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
-    var t_1: EpipolarTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX;
-    var j_1: u32 = 0u;
+fn epipolar_block_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_1: EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX, x_3: vec2<f32>, block: EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX, line_lo: vec4<f32>, line_hi: vec4<f32>, samples: u32) -> EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {
+    var b_2: EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX;
 
-    let d_3 = ((vec2<f32>(p_1) + vec2<f32>(0.5f, 0.5f)) - l_1.origin);
-    t_1 = pair;
-    let ws = pair.w.xy;
-    loop {
-        let _e15 = j_1;
-        if (_e15 < 2u) {
-        } else {
-            break;
-        }
-        {
-            let _e18 = j_1;
-            let line = select(line_lo, line_hi, (_e18 == 1u));
-            let g_1 = ((dot(d_3, line.xy) - line.z) / max(line.w, 0.00000000000000000001f));
-            let gc = clamp(g_1, 0f, f32((samples - 1u)));
-            let k_lo = min(u32(gc), (samples - 2u));
-            let fk = (gc - f32(k_lo));
-            let _e45 = j_1;
-            t_1.k[_e45] = k_lo;
-            let _e49 = j_1;
-            let _e52 = j_1;
-            t_1.w[(2u * _e49)] = (ws[_e52] * (1f - fk));
-            let _e59 = j_1;
-            let _e64 = j_1;
-            t_1.w[((2u * _e59) + 1u)] = (ws[_e64] * fk);
-        }
-        continuing {
-            let _e68 = j_1;
-            j_1 = (_e68 + 1u);
-        }
+    let d_3 = (x_3 - l_1.origin);
+    b_2 = block;
+    let s0_ = max(line_lo.w, 0.00000000000000000001f);
+    let s1_ = max(line_hi.w, 0.00000000000000000001f);
+    let g_1 = vec2<f32>(((dot(d_3, line_lo.xy) - line_lo.z) / s0_), ((dot(d_3, line_hi.xy) - line_hi.z) / s1_));
+    let gc = clamp(g_1, vec2<f32>(0f, 0f), vec2(f32((samples - 1u))));
+    b_2.k = min(vec2<u32>(gc), vec2((samples - 2u)));
+    let _e42 = b_2.k;
+    b_2.fk = (g_1 - vec2<f32>(_e42));
+    let _e47 = b_2.k;
+    b_2.fk_min = -(vec2<f32>(_e47));
+    let _e56 = b_2.k;
+    b_2.fk_max = (vec2(f32((samples - 1u))) - vec2<f32>(_e56));
+    b_2.gk_lo = (line_lo.xy / vec2(s0_));
+    b_2.gk_hi = (line_hi.xy / vec2(s1_));
+    let _e67 = b_2;
+    return _e67;
+}
+
+fn epipolar_block_weightsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(b_3: EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX, o: vec2<f32>) -> vec4<f32> {
+    var local_6: bool;
+    var local_7: bool;
+    var local_8: bool;
+
+    let own_s = clamp((b_3.fs + dot(b_3.gs, o)), b_3.fs_range.x, b_3.fs_range.y);
+    let own_k = clamp((b_3.fk + vec2<f32>(dot(b_3.gk_lo, o), dot(b_3.gk_hi, o))), b_3.fk_min, b_3.fk_max);
+    if !((own_s < -0.5f)) {
+        local_6 = (own_s > 1.5f);
+    } else {
+        local_6 = true;
     }
-    let _e70 = t_1;
-    return _e70;
+    let _e29 = local_6;
+    if !(_e29) {
+        local_7 = any((own_k < vec2<f32>(-0.5f, -0.5f)));
+    } else {
+        local_7 = true;
+    }
+    let _e39 = local_7;
+    if !(_e39) {
+        local_8 = any((own_k > vec2<f32>(1.5f, 1.5f)));
+    } else {
+        local_8 = true;
+    }
+    let beyond = local_8;
+    let fs = clamp(own_s, 0f, 1f);
+    let fk = clamp(own_k, vec2<f32>(0f, 0f), vec2<f32>(1f, 1f));
+    let w_3 = vec4<f32>(((1f - fs) * (1f - fk.x)), ((1f - fs) * fk.x), (fs * (1f - fk.y)), (fs * fk.y));
+    return select(w_3, vec4<f32>(0f, 0f, 0f, 0f), beyond);
 }
 
 fn phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(g: f32, cos_theta: f32) -> f32 {
@@ -275,63 +312,63 @@ fn phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(g: f32, cos_theta: f32) -> f
 }
 
 fn transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t: f32, len: f32) -> f32 {
-    let x_4 = (sigma_t * len);
-    if (x_4 < 0.0001f) {
-        return (len * (1f - (0.5f * x_4)));
+    let x_6 = (sigma_t * len);
+    if (x_6 < 0.0001f) {
+        return (len * (1f - (0.5f * x_6)));
     }
-    return ((1f - exp(-(x_4))) / sigma_t);
+    return ((1f - exp(-(x_6))) / sigma_t);
 }
 
-fn transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1: f32, a_1: f32, b_1: f32) -> f32 {
-    let _e7 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1, (b_1 - a_1));
+fn transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1: f32, a_1: f32, b_4: f32) -> f32 {
+    let _e7 = transmittance_integralX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(sigma_t_1, (b_4 - a_1));
     return (exp((-(sigma_t_1) * a_1)) * _e7);
 }
 
 fn cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(cos_angle: f32, cos_inner: f32, cos_outer: f32) -> f32 {
-    let x_5 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0f, 1f);
-    return select(((x_5 * x_5) * (3f - (2f * x_5))), select(0f, 1f, (cos_angle >= cos_outer)), ((cos_inner - cos_outer) <= 0.000001f));
+    let x_7 = clamp(((cos_angle - cos_outer) / (cos_inner - cos_outer)), 0f, 1f);
+    return select(((x_7 * x_7) * (3f - (2f * x_7))), select(0f, 1f, (cos_angle >= cos_outer)), ((cos_inner - cos_outer) <= 0.000001f));
 }
 
-fn spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye: vec3<f32>, dir: vec3<f32>, t_2: f32, light_pos: vec3<f32>, light_dir: vec3<f32>, cos_inner_1: f32, cos_outer_1: f32, medium: vec4<f32>) -> f32 {
-    let x_6 = (eye + (dir * t_2));
-    let to_x = (x_6 - light_pos);
+fn spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye: vec3<f32>, dir: vec3<f32>, t: f32, light_pos: vec3<f32>, light_dir: vec3<f32>, cos_inner_1: f32, cos_outer_1: f32, medium: vec4<f32>) -> f32 {
+    let x_8 = (eye + (dir * t));
+    let to_x = (x_8 - light_pos);
     let d2_ = max(dot(to_x, to_x), 0.000000000001f);
     let d_4 = sqrt(d2_);
     let travel = (to_x / vec3(d_4));
     let _e17 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(travel, light_dir), cos_inner_1, cos_outer_1);
     let _e22 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(medium.z, -(dot(travel, dir)));
-    return ((((medium.y * _e22) * _e17) * exp((-(medium.x) * (d_4 + t_2)))) / d2_);
+    return ((((medium.y * _e22) * _e17) * exp((-(medium.x) * (d_4 + t)))) / d2_);
 }
 
-fn equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1: vec3<f32>, dir_1: vec3<f32>, light_pos_1: vec3<f32>, a_2: f32, b_2: f32, n: u32) -> EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
+fn equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1: vec3<f32>, dir_1: vec3<f32>, light_pos_1: vec3<f32>, a_2: f32, b_5: f32, n: u32) -> EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX {
     let t0_ = dot((light_pos_1 - eye_1), dir_1);
-    let h_1 = max(length(((eye_1 + (dir_1 * t0_)) - light_pos_1)), (0.0001f * max((b_2 - a_2), 0.000001f)));
+    let h_1 = max(length(((eye_1 + (dir_1 * t0_)) - light_pos_1)), (0.0001f * max((b_5 - a_2), 0.000001f)));
     let theta_a = atan(((a_2 - t0_) / h_1));
-    return EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(t0_, h_1, theta_a, ((atan(((b_2 - t0_) / h_1)) - theta_a) / f32(n)));
+    return EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(t0_, h_1, theta_a, ((atan(((b_5 - t0_) / h_1)) - theta_a) / f32(n)));
 }
 
-fn equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(e: EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX, x_2: f32) -> vec2<f32> {
-    let tau = tan((e.theta_a + (x_2 * e.dtheta)));
+fn equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(e: EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX, x_4: f32) -> vec2<f32> {
+    let tau = tan((e.theta_a + (x_4 * e.dtheta)));
     return vec2<f32>((e.t_close + (e.dist * tau)), ((e.dtheta * e.dist) * (1f + (tau * tau))));
 }
 
-fn shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, p_2: vec3<f32>) -> vec3<f32> {
-    let q_1 = (p_2 - v.origin.xyz);
+fn shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, p: vec3<f32>) -> vec3<f32> {
+    let q_1 = (p - v.origin.xyz);
     return vec3<f32>(dot(q_1, v.right.xyz), dot(q_1, v.up.xyz), dot(q_1, v.forward.xyz));
 }
 
 fn shadow_uv_perspectiveX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_1: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, ls: vec3<f32>) -> vec2<f32> {
     let z_1 = max(ls.z, 0.000001f);
-    let t_5 = v_1.proj.x;
-    return vec2<f32>((0.5f + ((0.5f * ls.x) / (z_1 * t_5))), (0.5f - ((0.5f * ls.y) / (z_1 * t_5))));
+    let t_3 = v_1.proj.x;
+    return vec2<f32>((0.5f + ((0.5f * ls.x) / (z_1 * t_3))), (0.5f - ((0.5f * ls.y) / (z_1 * t_3))));
 }
 
 fn shadow_fetchX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_2: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, sm: texture_2d<f32>, uv: vec2<f32>) -> f32 {
     let outside = ((((uv.x < 0f) | (uv.x > 1f)) | (uv.y < 0f)) | (uv.y > 1f));
     let n_1 = v_2.size.x;
-    let x_7 = min(u32((uv.x * f32(n_1))), (n_1 - 1u));
+    let x_9 = min(u32((uv.x * f32(n_1))), (n_1 - 1u));
     let y_3 = min(u32((uv.y * f32(n_1))), (n_1 - 1u));
-    let _e36 = textureLoad(sm, vec2<u32>(x_7, y_3), 0i);
+    let _e36 = textureLoad(sm, vec2<u32>(x_9, y_3), 0i);
     return select(_e36.x, 2f, outside);
 }
 
@@ -349,8 +386,8 @@ fn shadow_bias_orthographicX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_5: Shadow
     return (v_5.forward.w * texel_1);
 }
 
-fn shadow_visibility_forX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, sm_1: texture_2d<f32>, p_3: vec3<f32>, perspective: bool) -> f32 {
-    let _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, p_3);
+fn shadow_visibility_forX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6: ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX, sm_1: texture_2d<f32>, p_1: vec3<f32>, perspective: bool) -> f32 {
+    let _e2 = shadow_light_spaceX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(v_6, p_1);
     let near = v_6.right.w;
     let far = v_6.up.w;
     if perspective {
@@ -376,84 +413,84 @@ fn fallback_list_reset() {
     return;
 }
 
-fn unwarp_pixel(q: vec2<u32>, w_1: vec4<f32>, depths_2: vec4<f32>, light_2: array<vec3<f32>, 4>) {
+fn unwarp_pixel(q: vec2<u32>, w_1: vec4<f32>, support_1: vec4<f32>, depths_2: vec4<f32>, light_2: array<vec3<f32>, 4>) {
     let _e3 = textureLoad(depth, q, 0i);
-    let _e10 = lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(w_1, depths_2, light_2, _e3.x, DEPTH_BREAK, LIGHT_BREAK);
-    if (_e10.w == 0f) {
-        let _e17 = atomicAdd((&fallback_count.listed), 1u);
-        fallback_pixels[_e17] = (q.x | (q.y << 16u));
-        if ((_e17 % 64u) == 0u) {
-            let g_2 = ((_e17 / 64u) + 1u);
-            let _e37 = atomicMax((&fallback_count.groups_x), min(g_2, FALLBACK_ROW_GROUPS));
-            let _e46 = atomicMax((&fallback_count.groups_y), (((g_2 + FALLBACK_ROW_GROUPS) - 1u) / FALLBACK_ROW_GROUPS));
+    let _e11 = lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(w_1, support_1, depths_2, light_2, _e3.x, DEPTH_BREAK, LIGHT_BREAK);
+    if (_e11.w == 0f) {
+        let _e18 = atomicAdd((&fallback_count.listed), 1u);
+        fallback_pixels[_e18] = (q.x | (q.y << 16u));
+        if ((_e18 % 64u) == 0u) {
+            let g_2 = ((_e18 / 64u) + 1u);
+            let _e38 = atomicMax((&fallback_count.groups_x), min(g_2, FALLBACK_ROW_GROUPS));
+            let _e47 = atomicMax((&fallback_count.groups_y), (((g_2 + FALLBACK_ROW_GROUPS) - 1u) / FALLBACK_ROW_GROUPS));
             return;
         } else {
             return;
         }
     } else {
-        textureStore(output, q, _e10);
+        textureStore(output, q, _e11);
         return;
     }
 }
 
-fn raymarch_pixel(x_3: u32, y_2: u32) -> vec3<f32> {
+fn raymarch_pixel(x_5: u32, y_2: u32) -> vec3<f32> {
     var sum_1: f32 = 0f;
-    var j_2: u32;
-    var t_3: f32;
+    var j_1: u32;
+    var t_1: f32;
     var w_2: f32;
     var l_2: f32;
 
     let m_2 = frame;
     let eye_2 = m_2.eye.xyz;
-    let _e7 = raymarch_pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m_2, x_3, y_2);
-    let _e11 = textureLoad(depth, vec2<u32>(x_3, y_2), 0i);
+    let _e7 = raymarch_pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m_2, x_5, y_2);
+    let _e11 = textureLoad(depth, vec2<u32>(x_5, y_2), 0i);
     let s = (min(max(_e11.x, 0f), m_2.eye.w) / max(dot(_e7, m_2.cam_forward.xyz), 0.000001f));
     let n_2 = m_2.sizes.w;
     let h_2 = (s / f32(n_2));
     let mx = m_2.interleave.x;
     let my = m_2.interleave.y;
     let stride = (mx * my);
-    let pixel_class = ((x_3 % mx) + (mx * (y_2 % my)));
-    let _e37 = pixel_jitterX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(x_3, y_2);
+    let pixel_class = ((x_5 % mx) + (mx * (y_2 % my)));
+    let _e37 = pixel_jitterX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(x_5, y_2);
     let u = select(0.5f, _e37, (m_2.interleave.z != 0u));
     let _e44 = raymarch_shadow_viewX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m_2);
     let _e48 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2, _e7, m_2.light_pos.xyz, 0f, s, n_2);
-    j_2 = pixel_class;
+    j_1 = pixel_class;
     loop {
-        let _e50 = j_2;
+        let _e50 = j_1;
         if (_e50 < n_2) {
         } else {
             break;
         }
         {
-            let _e52 = j_2;
-            t_3 = ((f32(_e52) + u) * h_2);
+            let _e52 = j_1;
+            t_1 = ((f32(_e52) + u) * h_2);
             w_2 = h_2;
             if false {
-                let _e59 = j_2;
+                let _e59 = j_1;
                 let _e62 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e48, (f32(_e59) + u));
-                t_3 = _e62.x;
+                t_1 = _e62.x;
                 w_2 = _e62.y;
             }
-            let _e65 = t_3;
+            let _e65 = t_1;
             let _e69 = shadow_visibility_forX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX(_e44, shadow_map, (eye_2 + (_e7 * _e65)), false);
             if false {
                 let _e71 = sum_1;
                 let _e72 = w_2;
-                let _e74 = t_3;
+                let _e74 = t_1;
                 let _e84 = spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2, _e7, _e74, m_2.light_pos.xyz, m_2.light_dir.xyz, m_2.light_pos.w, m_2.light_dir.w, m_2.medium);
                 sum_1 = (_e71 + ((_e69 * _e72) * _e84));
             } else {
                 let _e87 = sum_1;
-                let _e90 = j_2;
-                let _e93 = j_2;
+                let _e90 = j_1;
+                let _e93 = j_1;
                 let _e98 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(m_2.medium.x, (f32(_e90) * h_2), (f32((_e93 + 1u)) * h_2));
                 sum_1 = (_e87 + (_e69 * _e98));
             }
         }
         continuing {
-            let _e101 = j_2;
-            j_2 = (_e101 + stride);
+            let _e101 = j_1;
+            j_1 = (_e101 + stride);
         }
     }
     let _e103 = sum_1;
@@ -474,50 +511,79 @@ fn raymarch_unwarp(@builtin(global_invocation_id) id: vec3<u32>) {
     var depths: vec4<f32> = vec4<f32>(0f, 0f, 0f, 0f);
     var light: array<vec3<f32>, 4>;
     var j: u32 = 0u;
+    var i: u32 = 0u;
+    var local_1: bool;
 
     let _e6 = frame.sizes.x;
     let _e10 = frame.sizes.y;
     let screen = vec2<u32>(_e6, _e10);
-    let q_2 = id.xy;
-    if !((q_2.x >= screen.x)) {
-        local = (q_2.y >= screen.y);
+    let q0_ = (id.xy * UNWARP_BLOCK);
+    if !((q0_.x >= screen.x)) {
+        local = (q0_.y >= screen.y);
     } else {
         local = true;
     }
-    let _e24 = local;
-    if _e24 {
+    let _e26 = local;
+    if _e26 {
         return;
     }
     let head = textureLoad(epipolar_samples, vec2<u32>(0u, 256u), 0i);
     let angles = textureLoad(epipolar_samples, vec2<u32>(1u, 256u), 0i);
     let lines = EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(head.xy, head.zw, angles.x, angles.y, u32(angles.z));
-    let _e45 = epipolar_slicesX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, q_2, SLICES);
-    let line_lo_1 = textureLoad(epipolar_samples, vec2<u32>(SLICE_SAMPLES, _e45.slices.x), 0i);
-    let line_hi_1 = textureLoad(epipolar_samples, vec2<u32>(SLICE_SAMPLES, _e45.slices.y), 0i);
-    let _e61 = epipolar_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, q_2, _e45, line_lo_1, line_hi_1, SLICE_SAMPLES);
+    let centre = (vec2<f32>(q0_) + vec2(1f));
+    let _e51 = epipolar_block_slicesX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, centre, SLICES);
+    let line_lo_1 = textureLoad(epipolar_samples, vec2<u32>(SLICE_SAMPLES, _e51.slices.x), 0i);
+    let line_hi_1 = textureLoad(epipolar_samples, vec2<u32>(SLICE_SAMPLES, _e51.slices.y), 0i);
+    let _e67 = epipolar_block_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, centre, _e51, line_lo_1, line_hi_1, SLICE_SAMPLES);
     loop {
-        let _e63 = j;
-        if (_e63 < 4u) {
+        let _e69 = j;
+        if (_e69 < 4u) {
         } else {
             break;
         }
         {
-            let _e67 = j;
-            let _e71 = j;
-            let _e76 = j;
-            let v_7 = textureLoad(epipolar_samples, vec2<u32>((_e61.k[(_e67 / 2u)] + (_e71 % 2u)), _e61.slices[(_e76 / 2u)]), 0i);
-            let _e85 = j;
-            depths[_e85] = v_7.w;
-            let _e89 = j;
-            light[_e89] = v_7.xyz;
+            let _e73 = j;
+            let _e77 = j;
+            let _e82 = j;
+            let v_7 = textureLoad(epipolar_samples, vec2<u32>((_e67.k[(_e73 / 2u)] + (_e77 % 2u)), _e67.slices[(_e82 / 2u)]), 0i);
+            let _e91 = j;
+            depths[_e91] = v_7.w;
+            let _e95 = j;
+            light[_e95] = v_7.xyz;
         }
         continuing {
-            let _e93 = j;
-            j = (_e93 + 1u);
+            let _e99 = j;
+            j = (_e99 + 1u);
         }
     }
-    let _e96 = depths;
-    let _e97 = light;
-    unwarp_pixel(q_2, _e61.w, _e96, _e97);
+    let _e104 = epipolar_block_weightsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e67, vec2<f32>(0f, 0f));
+    loop {
+        let _e106 = i;
+        if (_e106 < 4u) {
+        } else {
+            break;
+        }
+        {
+            let _e109 = i;
+            let _e112 = i;
+            let q_2 = (q0_ + vec2<u32>((_e109 % UNWARP_BLOCK), (_e112 / UNWARP_BLOCK)));
+            if (q_2.x < screen.x) {
+                local_1 = (q_2.y < screen.y);
+            } else {
+                local_1 = false;
+            }
+            let _e126 = local_1;
+            if _e126 {
+                let _e133 = epipolar_block_weightsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e67, ((vec2<f32>(q_2) + vec2<f32>(0.5f, 0.5f)) - centre));
+                let _e134 = depths;
+                let _e135 = light;
+                unwarp_pixel(q_2, _e133, _e104, _e134, _e135);
+            }
+        }
+        continuing {
+            let _e137 = i;
+            i = (_e137 + 1u);
+        }
+    }
     return;
 }

@@ -126,7 +126,7 @@ bool depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(float a, float b, 
     return _e13;
 }
 
-vec4 lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(vec4 w, vec4 depths_1, vec3 light_1[4], float d, float depth_break_1, float light_break) {
+vec4 lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(vec4 w, vec4 support, vec4 depths_1, vec3 light_1[4], float d, float depth_break_1, float light_break) {
     vec3 sum = vec3(0.0, 0.0, 0.0);
     float total = 0.0;
     vec3 lo = vec3(3.4e38, 3.4e38, 3.4e38);
@@ -136,11 +136,12 @@ vec4 lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(vec4 w, vec4 dept
     uint k = 0u;
     bool local_3 = false;
     bool local_4 = false;
+    bool local_5 = false;
     bool loop_init = true;
     while(true) {
         if (!loop_init) {
-            uint _e63 = k;
-            k = (_e63 + 1u);
+            uint _e72 = k;
+            k = (_e72 + 1u);
         }
         loop_init = false;
         uint _e6 = k;
@@ -149,14 +150,14 @@ vec4 lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(vec4 w, vec4 dept
             break;
         }
         {
-            uint _e10 = taps;
-            uint _e12 = k;
-            taps = (_e10 + ((w[_e12] > 0.0) ? 1u : 0u));
-            uint _e20 = k;
-            if ((w[_e20] > 0.0)) {
-                uint _e25 = k;
-                bool _e29 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(depths_1[_e25], d, depth_break_1);
-                local_3 = _e29;
+            uint _e10 = k;
+            bool _e14 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(depths_1[_e10], d, depth_break_1);
+            uint _e16 = taps;
+            uint _e18 = k;
+            taps = (_e16 + ((support[_e18] > 0.0) ? 1u : 0u));
+            uint _e26 = k;
+            if ((support[_e26] > 0.0)) {
+                local_3 = _e14;
             } else {
                 local_3 = false;
             }
@@ -164,46 +165,55 @@ vec4 lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(vec4 w, vec4 dept
             if (_e33) {
                 uint _e35 = close;
                 close = (_e35 + 1u);
-                vec3 _e40 = sum;
+                vec3 _e40 = lo;
                 uint _e41 = k;
-                uint _e43 = k;
-                sum = (_e40 + (w[_e41] * light_1[_e43]));
-                float _e48 = total;
-                uint _e49 = k;
-                total = (_e48 + w[_e49]);
-                vec3 _e53 = lo;
-                uint _e54 = k;
-                lo = min(_e53, light_1[_e54]);
-                vec3 _e58 = hi;
-                uint _e59 = k;
-                hi = max(_e58, light_1[_e59]);
+                lo = min(_e40, light_1[_e41]);
+                vec3 _e45 = hi;
+                uint _e46 = k;
+                hi = max(_e45, light_1[_e46]);
+            }
+            uint _e50 = k;
+            if ((w[_e50] > 0.0)) {
+                local_4 = _e14;
+            } else {
+                local_4 = false;
+            }
+            bool _e57 = local_4;
+            if (_e57) {
+                vec3 _e59 = sum;
+                uint _e60 = k;
+                uint _e62 = k;
+                sum = (_e59 + (w[_e60] * light_1[_e62]));
+                float _e67 = total;
+                uint _e68 = k;
+                total = (_e67 + w[_e68]);
             }
         }
     }
-    float _e65 = total;
-    if (!((_e65 <= 0.0))) {
-        uint _e69 = close;
-        uint _e70 = taps;
-        local_4 = (_e69 < min(_e70, 2u));
+    float _e74 = total;
+    if (!((_e74 <= 0.0))) {
+        uint _e78 = close;
+        uint _e79 = taps;
+        local_5 = (_e78 < min(_e79, 2u));
     } else {
-        local_4 = true;
+        local_5 = true;
     }
-    bool _e77 = local_4;
-    if (_e77) {
+    bool _e86 = local_5;
+    if (_e86) {
         return vec4(0.0, 0.0, 0.0, 0.0);
     }
-    vec3 _e83 = hi;
-    vec3 _e84 = lo;
-    vec3 spread = (_e83 - _e84);
-    float _e93 = hi.x;
-    float _e95 = hi.y;
-    float _e97 = hi.z;
-    if ((max(spread.x, max(spread.y, spread.z)) > (light_break * max(_e93, max(_e95, _e97))))) {
+    vec3 _e92 = hi;
+    vec3 _e93 = lo;
+    vec3 spread = (_e92 - _e93);
+    float _e102 = hi.x;
+    float _e104 = hi.y;
+    float _e106 = hi.z;
+    if ((max(spread.x, max(spread.y, spread.z)) > (light_break * max(_e102, max(_e104, _e106))))) {
         return vec4(0.0, 0.0, 0.0, 0.0);
     }
-    vec3 _e107 = sum;
-    float _e108 = total;
-    vec3 c = (_e107 / vec3(_e108));
+    vec3 _e116 = sum;
+    float _e117 = total;
+    vec3 c = (_e116 / vec3(_e117));
     return vec4(c.x, c.y, c.z, 1.0);
 }
 
@@ -315,23 +325,23 @@ void fallback_list_reset() {
     return;
 }
 
-void unwarp_pixel(uvec2 q, vec4 w_1, vec4 depths_2, vec3 light_2[4]) {
+void unwarp_pixel(uvec2 q, vec4 w_1, vec4 support_1, vec4 depths_2, vec3 light_2[4]) {
     int _e3_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_1_cs) - 1);
     vec4 _e3 = texelFetch(_group_0_binding_1_cs, clamp(ivec2(q), ivec2(0), textureSize(_group_0_binding_1_cs, _e3_clamped_lod) - ivec2(1)), _e3_clamped_lod);
-    vec4 _e10 = lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(w_1, depths_2, light_2, _e3.x, DEPTH_BREAK, LIGHT_BREAK);
-    if ((_e10.w == 0.0)) {
-        uint _e17 = atomicAdd(_group_0_binding_5_cs.listed, 1u);
-        _group_0_binding_6_cs[_e17] = (q.x | (q.y << 16u));
-        if (((_e17 % 64u) == 0u)) {
-            uint g_1 = ((_e17 / 64u) + 1u);
-            uint _e37 = atomicMax(_group_0_binding_5_cs.groups_x, min(g_1, FALLBACK_ROW_GROUPS));
-            uint _e46 = atomicMax(_group_0_binding_5_cs.groups_y, (((g_1 + FALLBACK_ROW_GROUPS) - 1u) / FALLBACK_ROW_GROUPS));
+    vec4 _e11 = lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(w_1, support_1, depths_2, light_2, _e3.x, DEPTH_BREAK, LIGHT_BREAK);
+    if ((_e11.w == 0.0)) {
+        uint _e18 = atomicAdd(_group_0_binding_5_cs.listed, 1u);
+        _group_0_binding_6_cs[_e18] = (q.x | (q.y << 16u));
+        if (((_e18 % 64u) == 0u)) {
+            uint g_1 = ((_e18 / 64u) + 1u);
+            uint _e38 = atomicMax(_group_0_binding_5_cs.groups_x, min(g_1, FALLBACK_ROW_GROUPS));
+            uint _e47 = atomicMax(_group_0_binding_5_cs.groups_y, (((g_1 + FALLBACK_ROW_GROUPS) - 1u) / FALLBACK_ROW_GROUPS));
             return;
         } else {
             return;
         }
     } else {
-        imageStore(_group_0_binding_3_cs, ivec2(q), _e10);
+        imageStore(_group_0_binding_3_cs, ivec2(q), _e11);
         return;
     }
 }
@@ -405,9 +415,10 @@ void main() {
             bool _e79 = local_1;
             if (_e79) {
                 LowresTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e81 = lowres_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(q_2, screen_3, SCALE);
+                vec4 w_3 = _e81.w;
                 vec4 _e83 = depths;
                 vec3 _e84[4] = light;
-                unwarp_pixel(q_2, _e81.w, _e83, _e84);
+                unwarp_pixel(q_2, w_3, w_3, _e83, _e84);
             }
         }
     }

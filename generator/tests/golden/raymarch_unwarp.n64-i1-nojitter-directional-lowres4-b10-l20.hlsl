@@ -147,7 +147,7 @@ bool depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(float a, float b, 
     return _e13;
 }
 
-float4 lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(float4 w, float4 depths_1, float3 light_1[4], float d, float depth_break_1, float light_break)
+float4 lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(float4 w, float4 support, float4 depths_1, float3 light_1[4], float d, float depth_break_1, float light_break)
 {
     float3 sum = float3(0.0, 0.0, 0.0);
     float total = 0.0;
@@ -158,6 +158,7 @@ float4 lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(float4 w, float
     uint k = 0u;
     bool local_3 = (bool)0;
     bool local_4 = (bool)0;
+    bool local_5 = (bool)0;
 
     uint2 loop_bound = uint2(4294967295u, 4294967295u);
     bool loop_init = true;
@@ -165,8 +166,8 @@ float4 lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(float4 w, float
         if (all(loop_bound == uint2(0u, 0u))) { break; }
         loop_bound -= uint2(loop_bound.y == 0u, 1u);
         if (!loop_init) {
-            uint _e63 = k;
-            k = (_e63 + 1u);
+            uint _e72 = k;
+            k = (_e72 + 1u);
         }
         loop_init = false;
         uint _e6 = k;
@@ -175,14 +176,14 @@ float4 lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(float4 w, float
             break;
         }
         {
-            uint _e10 = taps;
-            uint _e12 = k;
-            taps = (_e10 + ((w[min(uint(_e12), 3u)] > 0.0) ? 1u : 0u));
-            uint _e20 = k;
-            if ((w[min(uint(_e20), 3u)] > 0.0)) {
-                uint _e25 = k;
-                const bool _e29 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(depths_1[min(uint(_e25), 3u)], d, depth_break_1);
-                local_3 = _e29;
+            uint _e10 = k;
+            const bool _e14 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(depths_1[min(uint(_e10), 3u)], d, depth_break_1);
+            uint _e16 = taps;
+            uint _e18 = k;
+            taps = (_e16 + ((support[min(uint(_e18), 3u)] > 0.0) ? 1u : 0u));
+            uint _e26 = k;
+            if ((support[min(uint(_e26), 3u)] > 0.0)) {
+                local_3 = _e14;
             } else {
                 local_3 = false;
             }
@@ -190,46 +191,55 @@ float4 lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(float4 w, float
             if (_e33) {
                 uint _e35 = close;
                 close = (_e35 + 1u);
-                float3 _e40 = sum;
+                float3 _e40 = lo;
                 uint _e41 = k;
-                uint _e43 = k;
-                sum = (_e40 + (w[min(uint(_e41), 3u)] * light_1[min(uint(_e43), 3u)]));
-                float _e48 = total;
-                uint _e49 = k;
-                total = (_e48 + w[min(uint(_e49), 3u)]);
-                float3 _e53 = lo;
-                uint _e54 = k;
-                lo = min(_e53, light_1[min(uint(_e54), 3u)]);
-                float3 _e58 = hi;
-                uint _e59 = k;
-                hi = max(_e58, light_1[min(uint(_e59), 3u)]);
+                lo = min(_e40, light_1[min(uint(_e41), 3u)]);
+                float3 _e45 = hi;
+                uint _e46 = k;
+                hi = max(_e45, light_1[min(uint(_e46), 3u)]);
+            }
+            uint _e50 = k;
+            if ((w[min(uint(_e50), 3u)] > 0.0)) {
+                local_4 = _e14;
+            } else {
+                local_4 = false;
+            }
+            bool _e57 = local_4;
+            if (_e57) {
+                float3 _e59 = sum;
+                uint _e60 = k;
+                uint _e62 = k;
+                sum = (_e59 + (w[min(uint(_e60), 3u)] * light_1[min(uint(_e62), 3u)]));
+                float _e67 = total;
+                uint _e68 = k;
+                total = (_e67 + w[min(uint(_e68), 3u)]);
             }
         }
     }
-    float _e65 = total;
-    if (!((_e65 <= 0.0))) {
-        uint _e69 = close;
-        uint _e70 = taps;
-        local_4 = (_e69 < min(_e70, 2u));
+    float _e74 = total;
+    if (!((_e74 <= 0.0))) {
+        uint _e78 = close;
+        uint _e79 = taps;
+        local_5 = (_e78 < min(_e79, 2u));
     } else {
-        local_4 = true;
+        local_5 = true;
     }
-    bool _e77 = local_4;
-    if (_e77) {
+    bool _e86 = local_5;
+    if (_e86) {
         return float4(0.0, 0.0, 0.0, 0.0);
     }
-    float3 _e83 = hi;
-    float3 _e84 = lo;
-    float3 spread = (_e83 - _e84);
-    float _e93 = hi.x;
-    float _e95 = hi.y;
-    float _e97 = hi.z;
-    if ((max(spread.x, max(spread.y, spread.z)) > (light_break * max(_e93, max(_e95, _e97))))) {
+    float3 _e92 = hi;
+    float3 _e93 = lo;
+    float3 spread = (_e92 - _e93);
+    float _e102 = hi.x;
+    float _e104 = hi.y;
+    float _e106 = hi.z;
+    if ((max(spread.x, max(spread.y, spread.z)) > (light_break * max(_e102, max(_e104, _e106))))) {
         return float4(0.0, 0.0, 0.0, 0.0);
     }
-    float3 _e107 = sum;
-    float _e108 = total;
-    float3 c = (_e107 / (_e108).xxx);
+    float3 _e116 = sum;
+    float _e117 = total;
+    float3 c = (_e116 / (_e117).xxx);
     return float4(c.x, c.y, c.z, 1.0);
 }
 
@@ -377,23 +387,23 @@ uint naga_div(uint lhs, uint rhs) {
     return lhs / (rhs == 0u ? 1u : rhs);
 }
 
-void unwarp_pixel(uint2 q, float4 w_1, float4 depths_2, float3 light_2[4])
+void unwarp_pixel(uint2 q, float4 w_1, float4 support_1, float4 depths_2, float3 light_2[4])
 {
     float4 _e3 = depth.Load(int3(q, int(0)));
-    const float4 _e10 = lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(w_1, depths_2, light_2, _e3.x, DEPTH_BREAK, LIGHT_BREAK);
-    if ((_e10.w == 0.0)) {
-        uint _e17; fallback_count.InterlockedAdd(0, 1u, _e17);
-        fallback_pixels.Store(_e17*4, asuint((q.x | (q.y << 16u))));
-        if ((naga_mod(_e17, 64u) == 0u)) {
-            uint g_1 = (naga_div(_e17, 64u) + 1u);
-            uint _e37; fallback_count.InterlockedMax(4, min(g_1, FALLBACK_ROW_GROUPS), _e37);
-            uint _e46; fallback_count.InterlockedMax(8, naga_div(((g_1 + FALLBACK_ROW_GROUPS) - 1u), FALLBACK_ROW_GROUPS), _e46);
+    const float4 _e11 = lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(w_1, support_1, depths_2, light_2, _e3.x, DEPTH_BREAK, LIGHT_BREAK);
+    if ((_e11.w == 0.0)) {
+        uint _e18; fallback_count.InterlockedAdd(0, 1u, _e18);
+        fallback_pixels.Store(_e18*4, asuint((q.x | (q.y << 16u))));
+        if ((naga_mod(_e18, 64u) == 0u)) {
+            uint g_1 = (naga_div(_e18, 64u) + 1u);
+            uint _e38; fallback_count.InterlockedMax(4, min(g_1, FALLBACK_ROW_GROUPS), _e38);
+            uint _e47; fallback_count.InterlockedMax(8, naga_div(((g_1 + FALLBACK_ROW_GROUPS) - 1u), FALLBACK_ROW_GROUPS), _e47);
             return;
         } else {
             return;
         }
     } else {
-        output[q] = _e10;
+        output[q] = _e11;
         return;
     }
 }
@@ -474,9 +484,10 @@ void raymarch_unwarp(uint3 id : SV_DispatchThreadID)
             bool _e79 = local_1;
             if (_e79) {
                 const LowresTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e81 = lowres_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(q_2, screen_3, SCALE);
+                float4 w_3 = _e81.w;
                 float4 _e83 = depths;
                 float3 _e84[4] = light;
-                unwarp_pixel(q_2, _e81.w, _e83, _e84);
+                unwarp_pixel(q_2, w_3, w_3, _e83, _e84);
             }
         }
     }

@@ -152,6 +152,7 @@ bool depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
 
 metal::float4 lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
     metal::float4 w,
+    metal::float4 support,
     metal::float4 depths_1,
     type_6 light_1,
     float d,
@@ -167,14 +168,15 @@ metal::float4 lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
     uint k = 0u;
     bool local_3 = {};
     bool local_4 = {};
+    bool local_5 = {};
     uint2 loop_bound = uint2(4294967295u);
     bool loop_init = true;
     while(true) {
         if (metal::all(loop_bound == uint2(0u))) { break; }
         loop_bound -= uint2(loop_bound.y == 0u, 1u);
         if (!loop_init) {
-            uint _e63 = k;
-            k = _e63 + 1u;
+            uint _e72 = k;
+            k = _e72 + 1u;
         }
         loop_init = false;
         uint _e6 = k;
@@ -183,14 +185,14 @@ metal::float4 lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
             break;
         }
         {
-            uint _e10 = taps;
-            uint _e12 = k;
-            taps = _e10 + ((w[metal::min(unsigned(_e12), 3u)] > 0.0) ? 1u : 0u);
-            uint _e20 = k;
-            if (w[metal::min(unsigned(_e20), 3u)] > 0.0) {
-                uint _e25 = k;
-                bool _e29 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(depths_1[metal::min(unsigned(_e25), 3u)], d, depth_break_1);
-                local_3 = _e29;
+            uint _e10 = k;
+            bool _e14 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(depths_1[metal::min(unsigned(_e10), 3u)], d, depth_break_1);
+            uint _e16 = taps;
+            uint _e18 = k;
+            taps = _e16 + ((support[metal::min(unsigned(_e18), 3u)] > 0.0) ? 1u : 0u);
+            uint _e26 = k;
+            if (support[metal::min(unsigned(_e26), 3u)] > 0.0) {
+                local_3 = _e14;
             } else {
                 local_3 = false;
             }
@@ -198,46 +200,55 @@ metal::float4 lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(
             if (_e33) {
                 uint _e35 = close;
                 close = _e35 + 1u;
-                metal::float3 _e40 = sum;
+                metal::float3 _e40 = lo;
                 uint _e41 = k;
-                uint _e43 = k;
-                sum = _e40 + (w[metal::min(unsigned(_e41), 3u)] * light_1.inner[metal::min(unsigned(_e43), 3u)]);
-                float _e48 = total;
-                uint _e49 = k;
-                total = _e48 + w[metal::min(unsigned(_e49), 3u)];
-                metal::float3 _e53 = lo;
-                uint _e54 = k;
-                lo = metal::min(_e53, light_1.inner[metal::min(unsigned(_e54), 3u)]);
-                metal::float3 _e58 = hi;
-                uint _e59 = k;
-                hi = metal::max(_e58, light_1.inner[metal::min(unsigned(_e59), 3u)]);
+                lo = metal::min(_e40, light_1.inner[metal::min(unsigned(_e41), 3u)]);
+                metal::float3 _e45 = hi;
+                uint _e46 = k;
+                hi = metal::max(_e45, light_1.inner[metal::min(unsigned(_e46), 3u)]);
+            }
+            uint _e50 = k;
+            if (w[metal::min(unsigned(_e50), 3u)] > 0.0) {
+                local_4 = _e14;
+            } else {
+                local_4 = false;
+            }
+            bool _e57 = local_4;
+            if (_e57) {
+                metal::float3 _e59 = sum;
+                uint _e60 = k;
+                uint _e62 = k;
+                sum = _e59 + (w[metal::min(unsigned(_e60), 3u)] * light_1.inner[metal::min(unsigned(_e62), 3u)]);
+                float _e67 = total;
+                uint _e68 = k;
+                total = _e67 + w[metal::min(unsigned(_e68), 3u)];
             }
         }
     }
-    float _e65 = total;
-    if (!((_e65 <= 0.0))) {
-        uint _e69 = close;
-        uint _e70 = taps;
-        local_4 = _e69 < metal::min(_e70, 2u);
+    float _e74 = total;
+    if (!((_e74 <= 0.0))) {
+        uint _e78 = close;
+        uint _e79 = taps;
+        local_5 = _e78 < metal::min(_e79, 2u);
     } else {
-        local_4 = true;
+        local_5 = true;
     }
-    bool _e77 = local_4;
-    if (_e77) {
+    bool _e86 = local_5;
+    if (_e86) {
         return metal::float4(0.0, 0.0, 0.0, 0.0);
     }
-    metal::float3 _e83 = hi;
-    metal::float3 _e84 = lo;
-    metal::float3 spread = _e83 - _e84;
-    float _e93 = hi.x;
-    float _e95 = hi.y;
-    float _e97 = hi.z;
-    if (metal::max(spread.x, metal::max(spread.y, spread.z)) > (light_break * metal::max(_e93, metal::max(_e95, _e97)))) {
+    metal::float3 _e92 = hi;
+    metal::float3 _e93 = lo;
+    metal::float3 spread = _e92 - _e93;
+    float _e102 = hi.x;
+    float _e104 = hi.y;
+    float _e106 = hi.z;
+    if (metal::max(spread.x, metal::max(spread.y, spread.z)) > (light_break * metal::max(_e102, metal::max(_e104, _e106)))) {
         return metal::float4(0.0, 0.0, 0.0, 0.0);
     }
-    metal::float3 _e107 = sum;
-    float _e108 = total;
-    metal::float3 c = _e107 / metal::float3(_e108);
+    metal::float3 _e116 = sum;
+    float _e117 = total;
+    metal::float3 c = _e116 / metal::float3(_e117);
     return metal::float4(c.x, c.y, c.z, 1.0);
 }
 
@@ -422,6 +433,7 @@ uint naga_div(uint lhs, uint rhs) {
 void unwarp_pixel(
     metal::uint2 q,
     metal::float4 w_1,
+    metal::float4 support_1,
     metal::float4 depths_2,
     type_6 light_2,
     metal::texture2d<float, metal::access::sample> depth,
@@ -432,20 +444,20 @@ void unwarp_pixel(
 ) {
     uint clamped_lod_e3 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
     metal::float4 _e3 = depth.read(metal::min(metal::uint2(q), metal::uint2(depth.get_width(clamped_lod_e3), depth.get_height(clamped_lod_e3)) - 1), clamped_lod_e3);
-    metal::float4 _e10 = lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(w_1, depths_2, light_2, _e3.x, DEPTH_BREAK, LIGHT_BREAK);
-    if (_e10.w == 0.0) {
-        uint _e17 = metal::atomic_fetch_add_explicit(&fallback_count.listed, 1u, metal::memory_order_relaxed);
-        fallback_pixels[metal::min(unsigned(_e17), (_buffer_sizes.size6 - 0 - 4) / 4)] = q.x | (q.y << 16u);
-        if (naga_mod(_e17, 64u) == 0u) {
-            uint g_1 = naga_div(_e17, 64u) + 1u;
-            uint _e37 = metal::atomic_fetch_max_explicit(&fallback_count.groups_x, metal::min(g_1, FALLBACK_ROW_GROUPS), metal::memory_order_relaxed);
-            uint _e46 = metal::atomic_fetch_max_explicit(&fallback_count.groups_y, naga_div((g_1 + FALLBACK_ROW_GROUPS) - 1u, FALLBACK_ROW_GROUPS), metal::memory_order_relaxed);
+    metal::float4 _e11 = lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(w_1, support_1, depths_2, light_2, _e3.x, DEPTH_BREAK, LIGHT_BREAK);
+    if (_e11.w == 0.0) {
+        uint _e18 = metal::atomic_fetch_add_explicit(&fallback_count.listed, 1u, metal::memory_order_relaxed);
+        fallback_pixels[metal::min(unsigned(_e18), (_buffer_sizes.size6 - 0 - 4) / 4)] = q.x | (q.y << 16u);
+        if (naga_mod(_e18, 64u) == 0u) {
+            uint g_1 = naga_div(_e18, 64u) + 1u;
+            uint _e38 = metal::atomic_fetch_max_explicit(&fallback_count.groups_x, metal::min(g_1, FALLBACK_ROW_GROUPS), metal::memory_order_relaxed);
+            uint _e47 = metal::atomic_fetch_max_explicit(&fallback_count.groups_y, naga_div((g_1 + FALLBACK_ROW_GROUPS) - 1u, FALLBACK_ROW_GROUPS), metal::memory_order_relaxed);
             return;
         } else {
             return;
         }
     } else {
-        output.write(_e10, metal::uint2(q));
+        output.write(_e11, metal::uint2(q));
         return;
     }
 }
@@ -618,9 +630,10 @@ kernel void raymarch_unwarp(
             bool _e79 = local_1;
             if (_e79) {
                 LowresTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e81 = lowres_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(q_2, screen_3, SCALE);
+                metal::float4 w_3 = _e81.w;
                 metal::float4 _e83 = depths;
                 type_6 _e84 = light;
-                unwarp_pixel(q_2, _e81.w, _e83, _e84, depth, output, fallback_count, fallback_pixels, _buffer_sizes);
+                unwarp_pixel(q_2, w_3, w_3, _e83, _e84, depth, output, fallback_count, fallback_pixels, _buffer_sizes);
             }
         }
     }

@@ -131,7 +131,7 @@ fn depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(a: f32, b: f32, dept
     return _e13;
 }
 
-fn lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(w: vec4<f32>, depths_1: vec4<f32>, light_1: array<vec3<f32>, 4>, d: f32, depth_break_1: f32, light_break: f32) -> vec4<f32> {
+fn lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(w: vec4<f32>, support: vec4<f32>, depths_1: vec4<f32>, light_1: array<vec3<f32>, 4>, d: f32, depth_break_1: f32, light_break: f32) -> vec4<f32> {
     var sum: vec3<f32> = vec3<f32>(0f, 0f, 0f);
     var total: f32 = 0f;
     var lo: vec3<f32> = vec3<f32>(340000000000000000000000000000000000000f, 340000000000000000000000000000000000000f, 340000000000000000000000000000000000000f);
@@ -141,6 +141,7 @@ fn lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(w: vec4<f32>, depth
     var k: u32 = 0u;
     var local_3: bool;
     var local_4: bool;
+    var local_5: bool;
 
     loop {
         let _e6 = k;
@@ -149,14 +150,14 @@ fn lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(w: vec4<f32>, depth
             break;
         }
         {
-            let _e10 = taps;
-            let _e12 = k;
-            taps = (_e10 + select(0u, 1u, (w[_e12] > 0f)));
-            let _e20 = k;
-            if (w[_e20] > 0f) {
-                let _e25 = k;
-                let _e29 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(depths_1[_e25], d, depth_break_1);
-                local_3 = _e29;
+            let _e10 = k;
+            let _e14 = depth_closeX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(depths_1[_e10], d, depth_break_1);
+            let _e16 = taps;
+            let _e18 = k;
+            taps = (_e16 + select(0u, 1u, (support[_e18] > 0f)));
+            let _e26 = k;
+            if (support[_e26] > 0f) {
+                local_3 = _e14;
             } else {
                 local_3 = false;
             }
@@ -164,50 +165,59 @@ fn lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(w: vec4<f32>, depth
             if _e33 {
                 let _e35 = close;
                 close = (_e35 + 1u);
-                let _e40 = sum;
+                let _e40 = lo;
                 let _e41 = k;
-                let _e43 = k;
-                sum = (_e40 + (w[_e41] * light_1[_e43]));
-                let _e48 = total;
-                let _e49 = k;
-                total = (_e48 + w[_e49]);
-                let _e53 = lo;
-                let _e54 = k;
-                lo = min(_e53, light_1[_e54]);
-                let _e58 = hi;
-                let _e59 = k;
-                hi = max(_e58, light_1[_e59]);
+                lo = min(_e40, light_1[_e41]);
+                let _e45 = hi;
+                let _e46 = k;
+                hi = max(_e45, light_1[_e46]);
+            }
+            let _e50 = k;
+            if (w[_e50] > 0f) {
+                local_4 = _e14;
+            } else {
+                local_4 = false;
+            }
+            let _e57 = local_4;
+            if _e57 {
+                let _e59 = sum;
+                let _e60 = k;
+                let _e62 = k;
+                sum = (_e59 + (w[_e60] * light_1[_e62]));
+                let _e67 = total;
+                let _e68 = k;
+                total = (_e67 + w[_e68]);
             }
         }
         continuing {
-            let _e63 = k;
-            k = (_e63 + 1u);
+            let _e72 = k;
+            k = (_e72 + 1u);
         }
     }
-    let _e65 = total;
-    if !((_e65 <= 0f)) {
-        let _e69 = close;
-        let _e70 = taps;
-        local_4 = (_e69 < min(_e70, 2u));
+    let _e74 = total;
+    if !((_e74 <= 0f)) {
+        let _e78 = close;
+        let _e79 = taps;
+        local_5 = (_e78 < min(_e79, 2u));
     } else {
-        local_4 = true;
+        local_5 = true;
     }
-    let _e77 = local_4;
-    if _e77 {
+    let _e86 = local_5;
+    if _e86 {
         return vec4<f32>(0f, 0f, 0f, 0f);
     }
-    let _e83 = hi;
-    let _e84 = lo;
-    let spread = (_e83 - _e84);
-    let _e93 = hi.x;
-    let _e95 = hi.y;
-    let _e97 = hi.z;
-    if (max(spread.x, max(spread.y, spread.z)) > (light_break * max(_e93, max(_e95, _e97)))) {
+    let _e92 = hi;
+    let _e93 = lo;
+    let spread = (_e92 - _e93);
+    let _e102 = hi.x;
+    let _e104 = hi.y;
+    let _e106 = hi.z;
+    if (max(spread.x, max(spread.y, spread.z)) > (light_break * max(_e102, max(_e104, _e106)))) {
         return vec4<f32>(0f, 0f, 0f, 0f);
     }
-    let _e107 = sum;
-    let _e108 = total;
-    let c = (_e107 / vec3(_e108));
+    let _e116 = sum;
+    let _e117 = total;
+    let c = (_e116 / vec3(_e117));
     return vec4<f32>(c.x, c.y, c.z, 1f);
 }
 
@@ -318,22 +328,22 @@ fn fallback_list_reset() {
     return;
 }
 
-fn unwarp_pixel(q: vec2<u32>, w_1: vec4<f32>, depths_2: vec4<f32>, light_2: array<vec3<f32>, 4>) {
+fn unwarp_pixel(q: vec2<u32>, w_1: vec4<f32>, support_1: vec4<f32>, depths_2: vec4<f32>, light_2: array<vec3<f32>, 4>) {
     let _e3 = textureLoad(depth, q, 0i);
-    let _e10 = lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(w_1, depths_2, light_2, _e3.x, DEPTH_BREAK, LIGHT_BREAK);
-    if (_e10.w == 0f) {
-        let _e17 = atomicAdd((&fallback_count.listed), 1u);
-        fallback_pixels[_e17] = (q.x | (q.y << 16u));
-        if ((_e17 % 64u) == 0u) {
-            let g_1 = ((_e17 / 64u) + 1u);
-            let _e37 = atomicMax((&fallback_count.groups_x), min(g_1, FALLBACK_ROW_GROUPS));
-            let _e46 = atomicMax((&fallback_count.groups_y), (((g_1 + FALLBACK_ROW_GROUPS) - 1u) / FALLBACK_ROW_GROUPS));
+    let _e11 = lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(w_1, support_1, depths_2, light_2, _e3.x, DEPTH_BREAK, LIGHT_BREAK);
+    if (_e11.w == 0f) {
+        let _e18 = atomicAdd((&fallback_count.listed), 1u);
+        fallback_pixels[_e18] = (q.x | (q.y << 16u));
+        if ((_e18 % 64u) == 0u) {
+            let g_1 = ((_e18 / 64u) + 1u);
+            let _e38 = atomicMax((&fallback_count.groups_x), min(g_1, FALLBACK_ROW_GROUPS));
+            let _e47 = atomicMax((&fallback_count.groups_y), (((g_1 + FALLBACK_ROW_GROUPS) - 1u) / FALLBACK_ROW_GROUPS));
             return;
         } else {
             return;
         }
     } else {
-        textureStore(output, q, _e10);
+        textureStore(output, q, _e11);
         return;
     }
 }
@@ -471,9 +481,10 @@ fn raymarch_unwarp(@builtin(global_invocation_id) id: vec3<u32>) {
             let _e79 = local_1;
             if _e79 {
                 let _e81 = lowres_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(q_2, screen_3, SCALE);
+                let w_3 = _e81.w;
                 let _e83 = depths;
                 let _e84 = light;
-                unwarp_pixel(q_2, _e81.w, _e83, _e84);
+                unwarp_pixel(q_2, w_3, w_3, _e83, _e84);
             }
         }
         continuing {

@@ -69,13 +69,14 @@ pub fn lowres_taps(p: [u32; 2], screen: [u32; 2], scale: u32) -> LowresTaps {
     }
 }
 
-/// The pixel's radiance from its taps (`w` bilinear weights, `depths` of the taps' pixels,
-/// `light` their radiance, `d` the pixel's depth): the bilinear blend of the taps with a
-/// positive weight that lie within `depth_break` of `d`; `None` where the pixel needs its
-/// own evaluation (no such tap, only one of several, or their spread over `light_break` of
-/// the brightest).
+/// The pixel's radiance from its taps (WGSL `lowres_blend`: `w` the blend's weights,
+/// `support` the weights that decide which taps stand around the pixel): the blend of the
+/// taps with a positive weight within `depth_break` of `d`, or `None` where the pixel needs
+/// its own evaluation (no such tap, only one close tap of several with positive support, or
+/// the close supported taps' light differs by more than `light_break` of the brightest).
 pub fn lowres_blend(
     w: [f32; 4],
+    support: [f32; 4],
     depths: [f32; 4],
     light: [[f32; 3]; 4],
     d: f32,
@@ -88,13 +89,18 @@ pub fn lowres_blend(
     let mut hi = [0.0f32; 3];
     let (mut taps, mut close) = (0u32, 0u32);
     for k in 0..4 {
-        taps += u32::from(w[k] > 0.0);
-        if w[k] > 0.0 && depth_close(depths[k], d, depth_break) {
+        let near = depth_close(depths[k], d, depth_break);
+        taps += u32::from(support[k] > 0.0);
+        if support[k] > 0.0 && near {
             close += 1;
             for c in 0..3 {
-                sum[c] += w[k] * light[k][c];
                 lo[c] = lo[c].min(light[k][c]);
                 hi[c] = hi[c].max(light[k][c]);
+            }
+        }
+        if w[k] > 0.0 && near {
+            for c in 0..3 {
+                sum[c] += w[k] * light[k][c];
             }
             total += w[k];
         }
@@ -200,10 +206,11 @@ pub fn run_sampled(
                     light[j] = c;
                 }
                 let d = depth.load(x, y);
-                match lowres_blend(t.w, depths, light, d, depth_break, light_break) {
+                match lowres_blend(t.w, t.w, depths, light, d, depth_break, light_break) {
                     Some(c) => (store(c), 0),
                     None => {
-                        let why = if lowres_blend(t.w, depths, light, d, depth_break, 1.0).is_none()
+                        let why = if lowres_blend(t.w, t.w, depths, light, d, depth_break, 1.0)
+                            .is_none()
                         {
                             1
                         } else {
@@ -453,7 +460,8 @@ pub fn slice_sample_pixel(
     })
 }
 
-/// The four samples a pixel is gathered from (WGSL `EpipolarTaps`).
+/// The four samples a pixel gathered alone takes, with their weights ([`epipolar_taps_direct`];
+/// the GPU gathers blocks of pixels, [`EpipolarBlock`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct EpipolarTaps {
     /// The two slices.
@@ -465,57 +473,115 @@ pub struct EpipolarTaps {
     pub w: [f32; 4],
 }
 
-/// The slices on either side of pixel `p`'s angle (`t.slices`), the second one's weight in
-/// `t.w[1]` (the rest is filled by [`epipolar_taps`]).
-pub fn epipolar_slices(l: &EpipolarLayout, p: [u32; 2], slices: u32) -> EpipolarTaps {
-    let d = [
-        p[0] as f32 + 0.5 - l.origin[0],
-        p[1] as f32 + 0.5 - l.origin[1],
-    ];
+/// The four samples a block of pixels is gathered from (WGSL `EpipolarBlock`: slices
+/// `slices`, samples (k[0], k[0] + 1) on the first and (k[1], k[1] + 1) on the second) and
+/// how a pixel's weights follow from its place in the block: at the block's centre the
+/// second slice's fraction `fs` and the fractions `fk` along each slice from sample k,
+/// unclamped, and their changes per pixel (`gs`, `gk`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EpipolarBlock {
+    /// The two slices.
+    pub slices: [u32; 2],
+    /// The first of the two samples on each slice.
+    pub k: [u32; 2],
+    /// The second slice's fraction at the block's centre, unclamped.
+    pub fs: f32,
+    /// Its change per pixel (x, y).
+    pub gs: [f32; 2],
+    /// On each slice, the fraction from sample `k` at the block's centre, unclamped.
+    pub fk: [f32; 2],
+    /// Their changes per pixel (x, y).
+    pub gk: [[f32; 2]; 2],
+    /// The range a pixel's own slice fraction keeps to (the fan's ends clamp it; unbounded
+    /// around a full circle).
+    pub fs_range: [f32; 2],
+    /// On each slice, the range a pixel's own fraction keeps to (the slice's ends).
+    pub fk_range: [[f32; 2]; 2],
+}
+
+/// The slices around point `x` (pixel coordinates; a block's centre) as a pixel centre there
+/// chooses them, with the slice fraction and its gradient (the angle's, perp(d) / |d|^2, over
+/// the angle per slice).
+pub fn epipolar_block_slices(l: &EpipolarLayout, x: [f32; 2], slices: u32) -> EpipolarBlock {
+    let d = [x[0] - l.origin[0], x[1] - l.origin[1]];
     let f = (epipolar_angle(l.axis, d) - l.phi_start) / l.dphi - 0.5;
-    let (s_lo, fs) = if l.wrap {
+    let (s_lo, base) = if l.wrap {
         let fl = f.floor();
-        (((fl as i32 + slices as i32) as u32) % slices, f - fl)
+        (((fl as i32 + slices as i32) as u32) % slices, fl)
     } else {
         let fc = f.clamp(0.0, (slices - 1) as f32);
         let s_lo = (fc as u32).min(slices - 2);
-        (s_lo, fc - s_lo as f32)
+        (s_lo, s_lo as f32)
     };
-    EpipolarTaps {
+    let r = (d[0] * d[0] + d[1] * d[1]).max(1e-20) * l.dphi;
+    EpipolarBlock {
         slices: [s_lo, (s_lo + 1) % slices],
         k: [0; 2],
-        w: [1.0 - fs, fs, 0.0, 0.0],
+        fs: f - base,
+        // (Low 12 mantissa bits cleared, as the WGSL does.)
+        gs: [-d[1] / r, d[0] / r].map(|g| f32::from_bits(g.to_bits() & 0xffff_f000)),
+        fk: [0.0; 2],
+        gk: [[0.0; 2]; 2],
+        fs_range: if l.wrap {
+            [-3.4e38, 3.4e38]
+        } else {
+            [-base, (slices - 1) as f32 - base]
+        },
+        fk_range: [[0.0; 2]; 2],
     }
 }
 
-/// The taps of pixel `p` from its slices `pair` ([`epipolar_slices`]) and their lines
-/// (direction, first distance, distance between samples: the samples' last column).
-pub fn epipolar_taps(
+/// The samples around point `x` on the block's slices ([`epipolar_block_slices`]) from their
+/// lines (direction, first distance, distance between samples: the samples' last column),
+/// with the fractions along the slices and their gradients (each slice's direction over its
+/// sample spacing: the distance along a slice is linear).
+pub fn epipolar_block_taps(
     l: &EpipolarLayout,
-    p: [u32; 2],
-    pair: EpipolarTaps,
+    x: [f32; 2],
+    block: EpipolarBlock,
     lines: [[f32; 4]; 2],
     samples: u32,
-) -> EpipolarTaps {
-    let d = [
-        p[0] as f32 + 0.5 - l.origin[0],
-        p[1] as f32 + 0.5 - l.origin[1],
-    ];
-    let mut t = pair;
-    let ws = [pair.w[0], pair.w[1]];
+) -> EpipolarBlock {
+    let d = [x[0] - l.origin[0], x[1] - l.origin[1]];
+    let mut b = block;
     for (j, line) in lines.iter().enumerate() {
-        let g = (d[0] * line[0] + d[1] * line[1] - line[2]) / line[3].max(1e-20);
+        let sp = line[3].max(1e-20);
+        let g = (d[0] * line[0] + d[1] * line[1] - line[2]) / sp;
         let gc = g.clamp(0.0, (samples - 1) as f32);
-        let k_lo = (gc as u32).min(samples - 2);
-        let fk = gc - k_lo as f32;
-        t.k[j] = k_lo;
-        t.w[2 * j] = ws[j] * (1.0 - fk);
-        t.w[2 * j + 1] = ws[j] * fk;
+        b.k[j] = (gc as u32).min(samples - 2);
+        b.fk[j] = g - b.k[j] as f32;
+        b.fk_range[j] = [-(b.k[j] as f32), (samples - 1) as f32 - b.k[j] as f32];
+        b.gk[j] = [line[0] / sp, line[1] / sp];
     }
-    t
+    b
 }
 
-/// The taps of pixel `p`, its slices' lines computed here (as the samples pass stores them).
+/// The bilinear weights of the block's four samples for the pixel whose centre lies `o` from
+/// the block's centre (WGSL `epipolar_block_weights`): the fractions moved by their gradients
+/// (kept to the ranges a pixel's own keep to) and clamped to [0, 1]; none where the pixel's own
+/// slice fraction lies more than half a slice beyond the block's slices (listed for the
+/// fallback).
+pub fn epipolar_block_weights(b: &EpipolarBlock, o: [f32; 2]) -> [f32; 4] {
+    let own_s = (b.fs + (b.gs[0] * o[0] + b.gs[1] * o[1])).clamp(b.fs_range[0], b.fs_range[1]);
+    let own_k = [0, 1].map(|j| {
+        (b.fk[j] + (b.gk[j][0] * o[0] + b.gk[j][1] * o[1]))
+            .clamp(b.fk_range[j][0], b.fk_range[j][1])
+    });
+    if !(-0.5..=1.5).contains(&own_s) {
+        return [0.0; 4];
+    }
+    let fs = own_s.clamp(0.0, 1.0);
+    let fk = own_k.map(|k| k.clamp(0.0, 1.0));
+    [
+        (1.0 - fs) * (1.0 - fk[0]),
+        (1.0 - fs) * fk[0],
+        fs * (1.0 - fk[1]),
+        fs * fk[1],
+    ]
+}
+
+/// The taps of pixel `p` gathered alone (a block of one pixel), its slices' lines computed
+/// here (as the samples pass stores them).
 pub fn epipolar_taps_direct(
     l: &EpipolarLayout,
     p: [u32; 2],
@@ -523,13 +589,19 @@ pub fn epipolar_taps_direct(
     slices: u32,
     samples: u32,
 ) -> EpipolarTaps {
-    let pair = epipolar_slices(l, p, slices);
+    let x = [p[0] as f32 + 0.5, p[1] as f32 + 0.5];
+    let pair = epipolar_block_slices(l, x, slices);
     let lines = pair.slices.map(|s| {
         let u = slice_direction(l, s);
         let span = slice_span(l, s, screen, samples);
         [u[0], u[1], span[0], span[1]]
     });
-    epipolar_taps(l, p, pair, lines, samples)
+    let b = epipolar_block_taps(l, x, pair, lines, samples);
+    EpipolarTaps {
+        slices: b.slices,
+        k: b.k,
+        w: epipolar_block_weights(&b, [0.0, 0.0]),
+    }
 }
 
 /// What the epipolar samples pass produced.
@@ -699,6 +771,9 @@ pub struct EpipolarUnwarp {
     pub depth_refined: u64,
     /// Of those, the ones whose samples' light differs.
     pub light_refined: u64,
+    /// Of those, the ones whose own samples lie more than half a spacing beyond their
+    /// block's (slices or samples denser than the block: [`epipolar_block_weights`]).
+    pub dense: u64,
 }
 
 /// Sampling pass 2 of `sampling = epipolar`, `<kernel>_unwarp`: every pixel gathered from
@@ -715,37 +790,63 @@ pub fn epipolar_unwarp(
     let (depth_break, light_break) = (knobs.depth_break_fraction(), knobs.light_break_fraction());
     let layout = layout_of(samples, knobs.slices);
     let store = |c: [f32; 3]| [c[0], c[1], c[2], 1.0].map(|v| quantise(v, Storage::Rgba16float));
-    let pixels: Vec<([f32; 4], u8)> = (0..h)
-        .into_par_iter()
-        .flat_map_iter(|y| {
-            let layout = &layout;
-            (0..w).map(move |x| {
-                let pair = epipolar_slices(layout, [x, y], knobs.slices);
+    // One block of B x B pixels per GPU invocation, sharing its four samples.
+    let bs = scatter_shaderlib::sampling::unwarp_block(knobs);
+    let mut pixels: Vec<([f32; 4], u8)> = vec![([0.0; 4], 0); (w * h) as usize];
+    pixels
+        .par_chunks_mut((w * bs) as usize)
+        .enumerate()
+        .for_each(|(by, rows)| {
+            let y0 = by as u32 * bs;
+            for x0 in (0..w).step_by(bs as usize) {
+                let centre = [x0 as f32 + 0.5 * bs as f32, y0 as f32 + 0.5 * bs as f32];
+                let pair = epipolar_block_slices(&layout, centre, knobs.slices);
                 let lines = pair.slices.map(|s| samples.load(knobs.slice_samples, s, 0));
-                let t = epipolar_taps(layout, [x, y], pair, lines, knobs.slice_samples);
+                let b = epipolar_block_taps(&layout, centre, pair, lines, knobs.slice_samples);
                 let mut depths = [0.0f32; 4];
                 let mut light = [[0.0f32; 3]; 4];
                 for j in 0..4 {
-                    let v = samples.load(t.k[j / 2] + (j % 2) as u32, t.slices[j / 2], 0);
+                    let v = samples.load(b.k[j / 2] + (j % 2) as u32, b.slices[j / 2], 0);
                     depths[j] = v[3];
                     light[j] = [v[0], v[1], v[2]];
                 }
-                let d = depth.load(x, y);
-                match lowres_blend(t.w, depths, light, d, depth_break, light_break) {
-                    Some(c) => (store(c), 0),
-                    None => {
-                        let why = if lowres_blend(t.w, depths, light, d, depth_break, 1.0).is_none()
-                        {
-                            1
-                        } else {
-                            2
-                        };
-                        ([0.0; 4], why)
+                let support = epipolar_block_weights(&b, [0.0, 0.0]);
+                for i in 0..bs * bs {
+                    let (x, y) = (x0 + i % bs, y0 + i / bs);
+                    if x >= w || y >= h {
+                        continue;
                     }
+                    let o = [x as f32 + 0.5 - centre[0], y as f32 + 0.5 - centre[1]];
+                    let wt = epipolar_block_weights(&b, o);
+                    let d = depth.load(x, y);
+                    rows[((y - y0) * w + x) as usize] =
+                        match lowres_blend(wt, support, depths, light, d, depth_break, light_break)
+                        {
+                            Some(c) => (store(c), 0),
+                            // Beyond the block's samples (no weights).
+                            None if wt == [0.0; 4] => ([0.0; 4], 3),
+                            None => {
+                                let why = if lowres_blend(
+                                    wt,
+                                    support,
+                                    depths,
+                                    light,
+                                    d,
+                                    depth_break,
+                                    1.0,
+                                )
+                                .is_none()
+                                {
+                                    1
+                                } else {
+                                    2
+                                };
+                                ([0.0; 4], why)
+                            }
+                        };
                 }
-            })
-        })
-        .collect();
+            }
+        });
     let fallback: Vec<[u32; 2]> = pixels
         .iter()
         .enumerate()
@@ -753,6 +854,7 @@ pub fn epipolar_unwarp(
         .map(|(i, _)| [i as u32 % w, i as u32 / w])
         .collect();
     let depth_refined = pixels.iter().filter(|p| p.1 == 1).count() as u64;
+    let dense = pixels.iter().filter(|p| p.1 == 3).count() as u64;
     EpipolarUnwarp {
         output: TexArray {
             width: w,
@@ -760,9 +862,10 @@ pub fn epipolar_unwarp(
             layers: 1,
             data: pixels.into_iter().map(|p| p.0).collect(),
         },
-        light_refined: fallback.len() as u64 - depth_refined,
+        light_refined: fallback.len() as u64 - depth_refined - dense,
         fallback,
         depth_refined,
+        dense,
     }
 }
 
@@ -779,6 +882,7 @@ pub fn epipolar_fallback(
         fallback,
         depth_refined,
         light_refined,
+        ..
     } = unwarped;
     let values: Vec<[f32; 4]> = fallback
         .par_iter()
@@ -847,14 +951,21 @@ mod tests {
             [0.9, 0.9, 0.9],
             [1.0, 1.0, 1.0],
         ];
-        let c = lowres_blend(t.w, [10.0; 4], light, 10.0, 0.05, 0.25).expect("blends");
+        let c = lowres_blend(t.w, t.w, [10.0; 4], light, 10.0, 0.05, 0.25).expect("blends");
         assert!((c[0] - 1.0).abs() < 1e-6);
         // A near occluder: no tap is close in depth.
-        assert_eq!(lowres_blend(t.w, [10.0; 4], light, 2.0, 0.05, 0.25), None);
+        assert_eq!(
+            lowres_blend(t.w, t.w, [10.0; 4], light, 2.0, 0.05, 0.25),
+            None
+        );
         // A shadow edge between the taps: their spread is over the light break.
-        assert_eq!(lowres_blend(t.w, [10.0; 4], light, 10.0, 0.05, 0.1), None);
+        assert_eq!(
+            lowres_blend(t.w, t.w, [10.0; 4], light, 10.0, 0.05, 0.1),
+            None
+        );
         // Only the taps close in depth count, for the blend and for the spread.
         let c = lowres_blend(
+            t.w,
             t.w,
             [10.0, 10.0, 2.0, 2.0],
             [[1.0; 3], [1.0; 3], [9.0; 3], [9.0; 3]],
@@ -867,6 +978,7 @@ mod tests {
         let inf = f32::INFINITY;
         assert!(
             lowres_blend(
+                t.w,
                 t.w,
                 [inf; 4],
                 [[0.0; 3], [5.0; 3], [0.0; 3], [0.0; 3]],
@@ -970,6 +1082,76 @@ mod tests {
             assert_eq!(
                 l.wrap,
                 toward == [0.2, 0.1, -1.0] || toward == [0.3, -0.2, 1.0]
+            );
+        }
+    }
+
+    #[test]
+    fn a_block_s_weights_are_its_pixels_own_where_they_share_its_samples() {
+        // The weights a block's pixel takes from the block's centre (the fractions moved by
+        // their gradients) against the pixel's own, gathered alone, wherever the pixel's own
+        // slices and samples are the block's; and in [0, 1] summing to 1 everywhere.
+        let screen = [67, 37];
+        let (slices, samples) = (16, 16);
+        for toward in [
+            [0.2, 0.1, -1.0],
+            [3.0, 0.5, -1.0],
+            [0.3, -0.2, 1.0],
+            [1.0, 0.3, 0.0],
+        ] {
+            let l = epipolar_layout(&camera(toward), screen, slices);
+            let (mut shared, mut worst, mut beyond) = (0, 0.0f32, 0);
+            for by in 0..(screen[1] / 2) {
+                for bx in 0..(screen[0] / 2) {
+                    let centre = [2.0 * bx as f32 + 1.0, 2.0 * by as f32 + 1.0];
+                    let pair = epipolar_block_slices(&l, centre, slices);
+                    let lines = pair.slices.map(|s| {
+                        let u = slice_direction(&l, s);
+                        let span = slice_span(&l, s, screen, samples);
+                        [u[0], u[1], span[0], span[1]]
+                    });
+                    let b = epipolar_block_taps(&l, centre, pair, lines, samples);
+                    for i in 0..4 {
+                        let p = [2 * bx + i % 2, 2 * by + i / 2];
+                        let o = [p[0] as f32 + 0.5 - centre[0], p[1] as f32 + 0.5 - centre[1]];
+                        let w = epipolar_block_weights(&b, o);
+                        let sum: f32 = w.iter().sum();
+                        assert!(
+                            w.iter().all(|&v| (0.0..=1.0).contains(&v)),
+                            "{toward:?} {p:?}: {w:?}"
+                        );
+                        let own = epipolar_taps_direct(&l, p, screen, slices, samples);
+                        if w == [0.0; 4] {
+                            // Beyond the block's samples: its own are others.
+                            assert!(
+                                own.slices != b.slices || own.k != b.k,
+                                "{toward:?} {p:?}: no weights, yet its own samples are the block's"
+                            );
+                            beyond += 1;
+                            continue;
+                        }
+                        assert!((sum - 1.0).abs() <= 1e-5, "{toward:?} {p:?}: {w:?}");
+                        if own.slices == b.slices && own.k == b.k {
+                            // (Within a few pixels of an on-screen epipole the angle is far
+                            // from linear over a block: there the slices are closer than a
+                            // pixel and any of them stands for the pixel.)
+                            let r = (p[0] as f32 + 0.5 - l.origin[0])
+                                .hypot(p[1] as f32 + 0.5 - l.origin[1]);
+                            if r >= 8.0 {
+                                shared += 1;
+                                for (a, b) in own.w.iter().zip(&w) {
+                                    worst = worst.max((a - b).abs());
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+            // (At 67x37 with 16 slices only the pixels next to an on-screen epipole lie beyond
+            // their block's slices.)
+            assert!(
+                shared > 0 && worst <= 0.02 && beyond * 50 <= screen[0] * screen[1],
+                "{toward:?}: {shared} shared, worst {worst}, {beyond} beyond"
             );
         }
     }

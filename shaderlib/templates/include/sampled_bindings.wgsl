@@ -12,6 +12,10 @@ const LIGHT_BREAK: f32 = {{ sampling.light_break }};
 const SLICES: u32 = {{ sampling.slices }}u;
 const SLICE_SAMPLES: u32 = {{ sampling.slice_samples }}u;
 const SLICE_LANES: u32 = {{ sampling.slice_lanes }}u;
+{%- if sampling.unwarp %}
+// Pixels per axis of the blocks the unwarp gathers from four samples each.
+const UNWARP_BLOCK: u32 = {{ sampling.unwarp_block }}u;
+{%- endif %}
 const STEP: u32 = {{ sampling.step }}u;
 // Runs of STEP samples from every STEP-th one (the samples pass's unit of work).
 const SLICE_RUNS: u32 = (SLICE_SAMPLES + STEP - 1u) / STEP;
@@ -67,11 +71,12 @@ fn fallback_list_reset() {
 @group(0) @binding({{ sampling.binding + 2 }}) var<storage, read_write> fallback_pixels: array<u32>;
 
 // The unwarp's end for pixel `q` (both sampled modes): the blend of its taps (`w` their
-// weights, `depths` their pixels' depths, `light` their radiance) kept by depth and light
-// spread (`lowres_blend`) into `output`, or `q` listed in `fallback_pixels` where they cannot
-// stand for it (nothing written).
-fn unwarp_pixel(q: vec2<u32>, w: vec4<f32>, depths: vec4<f32>, light: array<vec3<f32>, 4>) {
-    let c = lowres_blend(w, depths, light, textureLoad(depth, q, 0).x, DEPTH_BREAK, LIGHT_BREAK);
+// weights, `support` the weights that decide which stand around it, `depths` their pixels'
+// depths, `light` their radiance) kept by depth and light spread (`lowres_blend`) into
+// `output`, or `q` listed in `fallback_pixels` where they cannot stand for it (nothing
+// written).
+fn unwarp_pixel(q: vec2<u32>, w: vec4<f32>, support: vec4<f32>, depths: vec4<f32>, light: array<vec3<f32>, 4>) {
+    let c = lowres_blend(w, support, depths, light, textureLoad(depth, q, 0).x, DEPTH_BREAK, LIGHT_BREAK);
     if c.w == 0.0 {
         let e = atomicAdd(&fallback_count.listed, 1u);
         fallback_pixels[e] = q.x | (q.y << 16u);

@@ -54,7 +54,8 @@ fn {{ sampling.entry }}(@builtin(global_invocation_id) id: vec3<u32>) {
     for (var i = 0u; i < SCALE * SCALE; i++) {
         let q = q0 + vec2<u32>(i % SCALE, i / SCALE);
         if q.x < screen.x && q.y < screen.y {
-            unwarp_pixel(q, lowres_taps(q, screen, SCALE).w, depths, light);
+            let w = lowres_taps(q, screen, SCALE).w;
+            unwarp_pixel(q, w, w, depths, light);
         }
     }
 }
@@ -201,39 +202,54 @@ fn {{ sampling.entry }}(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_in
 }
 {%- else if sampling.unwarp %}
 
-// Sampling pass 2 (`sampling = epipolar`, scatter::sampling): invocation `id` gathers pixel
-// `id` from the four samples around it (`epipolar_slices`, then `epipolar_taps` with the two
-// slices' lines from the samples' last column: two slices, two samples on each) kept by
-// depth and light spread (`lowres_blend`), or, where they cannot stand for it, lists it in
-// `fallback_pixels` for pass 3 and writes nothing. Not evaluated here: llvmpipe runs an
-// `if` body under a mask for every lane whether or not one takes it, so an inlined
+// Sampling pass 2 (`sampling = epipolar`, scatter::sampling): invocation `id` gathers the
+// pixels of block `id` (B x B pixels from B id, B = UNWARP_BLOCK, those on the screen) from
+// the four samples around the block's centre (`epipolar_block_slices`, then
+// `epipolar_block_taps` with the two slices' lines from the samples' last column: two
+// slices, two samples on each), loaded once for the block: each pixel takes them with its
+// own weights (`epipolar_block_weights`: the centre's fractions moved by their gradients,
+// clamped to the block's samples), kept by depth and light spread as the centre's weights
+// would keep them (`lowres_blend`'s support: so that a pixel clamped onto one slice or one
+// sample still sees the others for both criteria), or, where they cannot stand for it, is
+// listed in `fallback_pixels` for pass 3 and nothing written. With B = 2 the pass took 15.7
+// against 22.0 ms per pixel at 1280x720 (llvmpipe pays about 1 ms per texel load and 1 ms
+// per `atan2` over the screen; docs/roofline.md, "Stop 52"). Not evaluated here: llvmpipe
+// runs an `if` body under a mask for every lane whether or not one takes it, so an inlined
 // per-pixel body cost every pixel its set-up (unwarp 32-87 ms at 1280x720 against 25-37 ms
 // without it); and not in a workgroup list either: a barrier splits the kernel into
-// resumable parts, which cost 20-60 ms more. Dispatch: (ceil(W / 8), ceil(H / 8), 1)
-// workgroups of (8, 8, 1).
+// resumable parts, which cost 20-60 ms more. Dispatch: (ceil(ceil(W / B) / 8),
+// ceil(ceil(H / B) / 8), 1) workgroups of (8, 8, 1).
 @compute @workgroup_size(8, 8, 1)
 fn {{ sampling.entry }}(@builtin(global_invocation_id) id: vec3<u32>) {
     let screen = vec2<u32>(frame.sizes[0], frame.sizes[1]);
-    let q = id.xy;
-    if q.x >= screen.x || q.y >= screen.y {
+    let q0 = id.xy * UNWARP_BLOCK;
+    if q0.x >= screen.x || q0.y >= screen.y {
         return;
     }
     // The layout the samples pass computed (the last row of `epipolar_samples`).
     let head = textureLoad(epipolar_samples, vec2<u32>(0u, SLICES), 0);
     let angles = textureLoad(epipolar_samples, vec2<u32>(1u, SLICES), 0);
     let lines = EpipolarLayout(head.xy, head.zw, angles.x, angles.y, u32(angles.z));
-    let pair = epipolar_slices(lines, q, SLICES);
+    let centre = vec2<f32>(q0) + vec2<f32>(0.5 * f32(UNWARP_BLOCK));
+    let pair = epipolar_block_slices(lines, centre, SLICES);
     let line_lo = textureLoad(epipolar_samples, vec2<u32>(SLICE_SAMPLES, pair.slices.x), 0);
     let line_hi = textureLoad(epipolar_samples, vec2<u32>(SLICE_SAMPLES, pair.slices.y), 0);
-    let t = epipolar_taps(lines, q, pair, line_lo, line_hi, SLICE_SAMPLES);
+    let b = epipolar_block_taps(lines, centre, pair, line_lo, line_hi, SLICE_SAMPLES);
     var depths = vec4<f32>(0.0, 0.0, 0.0, 0.0);
     var light: array<vec3<f32>, 4>;
     for (var j = 0u; j < 4u; j++) {
-        let v = textureLoad(epipolar_samples, vec2<u32>(t.k[j / 2u] + j % 2u, t.slices[j / 2u]), 0);
+        let v = textureLoad(epipolar_samples, vec2<u32>(b.k[j / 2u] + j % 2u, b.slices[j / 2u]), 0);
         depths[j] = v.w;
         light[j] = v.xyz;
     }
-    unwarp_pixel(q, t.w, depths, light);
+    let support = epipolar_block_weights(b, vec2<f32>(0.0, 0.0));
+    for (var i = 0u; i < UNWARP_BLOCK * UNWARP_BLOCK; i++) {
+        let q = q0 + vec2<u32>(i % UNWARP_BLOCK, i / UNWARP_BLOCK);
+        if q.x < screen.x && q.y < screen.y {
+            let w = epipolar_block_weights(b, vec2<f32>(q) + vec2<f32>(0.5, 0.5) - centre);
+            unwarp_pixel(q, w, support, depths, light);
+        }
+    }
 }
 {%- else if sampling.fallback %}
 
