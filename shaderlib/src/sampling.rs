@@ -309,11 +309,15 @@ pub fn unwarp_pass(
 
 /// Pixels per axis of the blocks the epipolar unwarp gathers: the four samples around a
 /// block's centre, loaded once, stand for its pixels, each with its own weights (the centre's
-/// fractions moved by their gradients, clamped to the block's samples). Measured at 1280x720
-/// (minmax, 256 slices, a 1024x256 map; docs/roofline.md, "Stop 52"): the unwarp 22.0 ->
-/// 15.7 ms on a slow hour, 3 rounds, and on the 24 suite poses the same rel L1 to within 0.02
-/// points but where a block spans more than a slice (near an on-screen epipole), whose
-/// pixels are evaluated per pixel instead. One invocation per pixel was the unwarp before;
+/// fractions moved by their gradients, clamped to the block's samples: at most 0.71 pixel from
+/// the pixel's own place), but a pixel whose own slice lies more than half a slice beyond the
+/// block's (slices closer than a pixel: near an on-screen epipole, small screens) is listed for
+/// the fallback. Measured at 1280x720 (docs/roofline.md, "Stop 53"; minmax, 256 slices, a
+/// 1024x256 map, 6 rounds alternated): `minmax_traverse_unwarp` 19.2-19.6 -> 13.3-15.7 ms,
+/// the frame's passes 33.6-42.4 -> 27.2-39.1 ms; on the 24 suite poses the mean rel L1
+/// against the truth 0.5017 -> 0.5020 %, no pose worse by more than 0.029 points (spot_grate
+/// ordinary), 855344 -> 880947 pixels listed in all. One invocation per pixel was the unwarp
+/// before;
 /// a 2 x 2 quad gathering each pixel's own taps from shared loads of three slices (14 loads
 /// for four pixels instead of 32) saved nothing (13.3-14.2 ms against 13.9-14.3 even with
 /// the pixels whose taps it had not loaded left wrong, 19.4-22.9 ms with them loading their

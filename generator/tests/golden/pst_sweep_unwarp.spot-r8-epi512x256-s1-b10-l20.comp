@@ -673,8 +673,6 @@ EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_block_tapsX_
 
 vec4 epipolar_block_weightsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX b_9, vec2 o_2) {
     bool local_7 = false;
-    bool local_8 = false;
-    bool local_9 = false;
     float own_s = clamp((b_9.fs + dot(b_9.gs, o_2)), b_9.fs_range.x, b_9.fs_range.y);
     vec2 own_k = clamp((b_9.fk + vec2(dot(b_9.gk_lo, o_2), dot(b_9.gk_hi, o_2))), b_9.fk_min, b_9.fk_max);
     if (!((own_s < -0.5))) {
@@ -682,19 +680,7 @@ vec4 epipolar_block_weightsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(Epipola
     } else {
         local_7 = true;
     }
-    bool _e29 = local_7;
-    if (!(_e29)) {
-        local_8 = any(lessThan(own_k, vec2(-0.5, -0.5)));
-    } else {
-        local_8 = true;
-    }
-    bool _e39 = local_8;
-    if (!(_e39)) {
-        local_9 = any(greaterThan(own_k, vec2(1.5, 1.5)));
-    } else {
-        local_9 = true;
-    }
-    bool beyond = local_9;
+    bool beyond = local_7;
     float fs = clamp(own_s, 0.0, 1.0);
     vec2 fk = clamp(own_k, vec2(0.0, 0.0), vec2(1.0, 1.0));
     vec4 w_4 = vec4(((1.0 - fs) * (1.0 - fk.x)), ((1.0 - fs) * fk.x), (fs * (1.0 - fk.y)), (fs * fk.y));

@@ -800,8 +800,6 @@ EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_block_tapsX_
 float4 epipolar_block_weightsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX b_9, float2 o_2)
 {
     bool local_7 = (bool)0;
-    bool local_8 = (bool)0;
-    bool local_9 = (bool)0;
 
     float own_s = clamp((b_9.fs + dot(b_9.gs, o_2)), b_9.fs_range.x, b_9.fs_range.y);
     float2 own_k = clamp((b_9.fk + float2(dot(b_9.gk_lo, o_2), dot(b_9.gk_hi, o_2))), b_9.fk_min, b_9.fk_max);
@@ -810,19 +808,7 @@ float4 epipolar_block_weightsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(Epipo
     } else {
         local_7 = true;
     }
-    bool _e29 = local_7;
-    if (!(_e29)) {
-        local_8 = any((own_k < float2(-0.5, -0.5)));
-    } else {
-        local_8 = true;
-    }
-    bool _e39 = local_8;
-    if (!(_e39)) {
-        local_9 = any((own_k > float2(1.5, 1.5)));
-    } else {
-        local_9 = true;
-    }
-    bool beyond = local_9;
+    bool beyond = local_7;
     float fs = clamp(own_s, 0.0, 1.0);
     float2 fk = clamp(own_k, float2(0.0, 0.0), float2(1.0, 1.0));
     float4 w_4 = float4(((1.0 - fs) * (1.0 - fk.x)), ((1.0 - fs) * fk.x), (fs * (1.0 - fk.y)), (fs * fk.y));

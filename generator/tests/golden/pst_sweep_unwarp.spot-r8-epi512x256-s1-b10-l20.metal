@@ -920,8 +920,6 @@ metal::float4 epipolar_block_weightsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQ
     metal::float2 o_2
 ) {
     bool local_7 = {};
-    bool local_8 = {};
-    bool local_9 = {};
     float own_s = metal::clamp(b_9.fs + metal::dot(b_9.gs, o_2), b_9.fs_range.x, b_9.fs_range.y);
     metal::float2 own_k = metal::clamp(b_9.fk + metal::float2(metal::dot(b_9.gk_lo, o_2), metal::dot(b_9.gk_hi, o_2)), b_9.fk_min, b_9.fk_max);
     if (!((own_s < -0.5))) {
@@ -929,19 +927,7 @@ metal::float4 epipolar_block_weightsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQ
     } else {
         local_7 = true;
     }
-    bool _e29 = local_7;
-    if (!(_e29)) {
-        local_8 = metal::any(own_k < metal::float2(-0.5, -0.5));
-    } else {
-        local_8 = true;
-    }
-    bool _e39 = local_8;
-    if (!(_e39)) {
-        local_9 = metal::any(own_k > metal::float2(1.5, 1.5));
-    } else {
-        local_9 = true;
-    }
-    bool beyond = local_9;
+    bool beyond = local_7;
     float fs = metal::clamp(own_s, 0.0, 1.0);
     metal::float2 fk = metal::clamp(own_k, metal::float2(0.0, 0.0), metal::float2(1.0, 1.0));
     metal::float4 w_4 = metal::float4((1.0 - fs) * (1.0 - fk.x), (1.0 - fs) * fk.x, fs * (1.0 - fk.y), fs * fk.y);

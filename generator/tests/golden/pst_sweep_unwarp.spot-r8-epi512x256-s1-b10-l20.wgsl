@@ -682,8 +682,6 @@ fn epipolar_block_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_2: Epipola
 
 fn epipolar_block_weightsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(b_9: EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX, o_2: vec2<f32>) -> vec4<f32> {
     var local_7: bool;
-    var local_8: bool;
-    var local_9: bool;
 
     let own_s = clamp((b_9.fs + dot(b_9.gs, o_2)), b_9.fs_range.x, b_9.fs_range.y);
     let own_k = clamp((b_9.fk + vec2<f32>(dot(b_9.gk_lo, o_2), dot(b_9.gk_hi, o_2))), b_9.fk_min, b_9.fk_max);
@@ -692,19 +690,7 @@ fn epipolar_block_weightsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(b_9: Epip
     } else {
         local_7 = true;
     }
-    let _e29 = local_7;
-    if !(_e29) {
-        local_8 = any((own_k < vec2<f32>(-0.5f, -0.5f)));
-    } else {
-        local_8 = true;
-    }
-    let _e39 = local_8;
-    if !(_e39) {
-        local_9 = any((own_k > vec2<f32>(1.5f, 1.5f)));
-    } else {
-        local_9 = true;
-    }
-    let beyond = local_9;
+    let beyond = local_7;
     let fs = clamp(own_s, 0f, 1f);
     let fk = clamp(own_k, vec2<f32>(0f, 0f), vec2<f32>(1f, 1f));
     let w_4 = vec4<f32>(((1f - fs) * (1f - fk.x)), ((1f - fs) * fk.x), (fs * (1f - fk.y)), (fs * fk.y));

@@ -271,8 +271,6 @@ EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_block_tapsX_
 
 vec4 epipolar_block_weightsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX b_3, vec2 o) {
     bool local_6 = false;
-    bool local_7 = false;
-    bool local_8 = false;
     float own_s = clamp((b_3.fs + dot(b_3.gs, o)), b_3.fs_range.x, b_3.fs_range.y);
     vec2 own_k = clamp((b_3.fk + vec2(dot(b_3.gk_lo, o), dot(b_3.gk_hi, o))), b_3.fk_min, b_3.fk_max);
     if (!((own_s < -0.5))) {
@@ -280,19 +278,7 @@ vec4 epipolar_block_weightsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(Epipola
     } else {
         local_6 = true;
     }
-    bool _e29 = local_6;
-    if (!(_e29)) {
-        local_7 = any(lessThan(own_k, vec2(-0.5, -0.5)));
-    } else {
-        local_7 = true;
-    }
-    bool _e39 = local_7;
-    if (!(_e39)) {
-        local_8 = any(greaterThan(own_k, vec2(1.5, 1.5)));
-    } else {
-        local_8 = true;
-    }
-    bool beyond = local_8;
+    bool beyond = local_6;
     float fs = clamp(own_s, 0.0, 1.0);
     vec2 fk = clamp(own_k, vec2(0.0, 0.0), vec2(1.0, 1.0));
     vec4 w_3 = vec4(((1.0 - fs) * (1.0 - fk.x)), ((1.0 - fs) * fk.x), (fs * (1.0 - fk.y)), (fs * fk.y));

@@ -315,8 +315,6 @@ EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX epipolar_block_tapsX_
 float4 epipolar_block_weightsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX b_3, float2 o)
 {
     bool local_6 = (bool)0;
-    bool local_7 = (bool)0;
-    bool local_8 = (bool)0;
 
     float own_s = clamp((b_3.fs + dot(b_3.gs, o)), b_3.fs_range.x, b_3.fs_range.y);
     float2 own_k = clamp((b_3.fk + float2(dot(b_3.gk_lo, o), dot(b_3.gk_hi, o))), b_3.fk_min, b_3.fk_max);
@@ -325,19 +323,7 @@ float4 epipolar_block_weightsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(Epipo
     } else {
         local_6 = true;
     }
-    bool _e29 = local_6;
-    if (!(_e29)) {
-        local_7 = any((own_k < float2(-0.5, -0.5)));
-    } else {
-        local_7 = true;
-    }
-    bool _e39 = local_7;
-    if (!(_e39)) {
-        local_8 = any((own_k > float2(1.5, 1.5)));
-    } else {
-        local_8 = true;
-    }
-    bool beyond = local_8;
+    bool beyond = local_6;
     float fs = clamp(own_s, 0.0, 1.0);
     float2 fk = clamp(own_k, float2(0.0, 0.0), float2(1.0, 1.0));
     float4 w_3 = float4(((1.0 - fs) * (1.0 - fk.x)), ((1.0 - fs) * fk.x), (fs * (1.0 - fk.y)), (fs * fk.y));

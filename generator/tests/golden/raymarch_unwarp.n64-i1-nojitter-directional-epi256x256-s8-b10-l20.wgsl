@@ -277,8 +277,6 @@ fn epipolar_block_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(l_1: Epipola
 
 fn epipolar_block_weightsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(b_3: EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX, o: vec2<f32>) -> vec4<f32> {
     var local_6: bool;
-    var local_7: bool;
-    var local_8: bool;
 
     let own_s = clamp((b_3.fs + dot(b_3.gs, o)), b_3.fs_range.x, b_3.fs_range.y);
     let own_k = clamp((b_3.fk + vec2<f32>(dot(b_3.gk_lo, o), dot(b_3.gk_hi, o))), b_3.fk_min, b_3.fk_max);
@@ -287,19 +285,7 @@ fn epipolar_block_weightsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(b_3: Epip
     } else {
         local_6 = true;
     }
-    let _e29 = local_6;
-    if !(_e29) {
-        local_7 = any((own_k < vec2<f32>(-0.5f, -0.5f)));
-    } else {
-        local_7 = true;
-    }
-    let _e39 = local_7;
-    if !(_e39) {
-        local_8 = any((own_k > vec2<f32>(1.5f, 1.5f)));
-    } else {
-        local_8 = true;
-    }
-    let beyond = local_8;
+    let beyond = local_6;
     let fs = clamp(own_s, 0f, 1f);
     let fk = clamp(own_k, vec2<f32>(0f, 0f), vec2<f32>(1f, 1f));
     let w_3 = vec4<f32>(((1f - fs) * (1f - fk.x)), ((1f - fs) * fk.x), (fs * (1f - fk.y)), (fs * fk.y));

@@ -211,9 +211,11 @@ fn {{ sampling.entry }}(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_in
 // clamped to the block's samples), kept by depth and light spread as the centre's weights
 // would keep them (`lowres_blend`'s support: so that a pixel clamped onto one slice or one
 // sample still sees the others for both criteria), or, where they cannot stand for it, is
-// listed in `fallback_pixels` for pass 3 and nothing written. With B = 2 the pass took 15.7
-// against 22.0 ms per pixel at 1280x720 (llvmpipe pays about 1 ms per texel load and 1 ms
-// per `atan2` over the screen; docs/roofline.md, "Stop 52"). Not evaluated here: llvmpipe
+// listed in `fallback_pixels` for pass 3 and nothing written (as is a pixel whose own slice
+// lies more than half a slice beyond the block's: slices closer than a pixel). With B = 2
+// `minmax_traverse_unwarp` took 13.3-15.7 against 19.2-19.6 ms per pixel at 1280x720
+// (llvmpipe pays about 1 ms per texel load and 1 ms per `atan2` over the screen;
+// docs/roofline.md, "Stop 53"). Not evaluated here: llvmpipe
 // runs an `if` body under a mask for every lane whether or not one takes it, so an inlined
 // per-pixel body cost every pixel its set-up (unwarp 32-87 ms at 1280x720 against 25-37 ms
 // without it); and not in a workgroup list either: a barrier splits the kernel into
