@@ -625,26 +625,22 @@ pub fn kernel_costs() -> Vec<KernelCost> {
     out.push(KernelCost {
         method: "partial_sum_tree r4",
         kernel: "pst_sweep_unwarp",
-        invocations: pixels,
-        // The shared epipolar unwarp (`raymarch n64 ep512`'s `raymarch_unwarp` line): the
-        // layout (two loads), the two slices' lines, four sample loads and the pixel's
-        // depth; one atan2 (the pixel's angle) and three divisions, the bilinear weights and
-        // the depth- and light-aware blend (about 90 FMAs); the rgba16float store.
-        counts: [8.0, 9.0, 0.0, 4.0, 90.0],
+        invocations: w.div_ceil(2) * h.div_ceil(2),
+        // The shared epipolar unwarp (`raymarch n64 ep512`'s `raymarch_unwarp` line).
+        counts: EPIPOLAR_UNWARP,
         low: None,
-        trips: "4 taps",
+        trips: "2 x 2 pixels x 4 taps",
     });
     out.push(KernelCost {
         method: "partial_sum_tree r4",
         kernel: "pst_sweep_fallback",
+        // Dispatched indirectly, one invocation per listed pixel: the ray set-up and every
+        // column of its row summed without the tree (Wr rectified loads, the leaves' two
+        // factor loads each). Counted for one pixel listed per 8 x 8 (1.6 %).
         invocations: pixels.div_ceil(64),
-        // One invocation per 8 x 8 pixels walks the list: per listed pixel the ray set-up
-        // and every column of its row summed without the tree (Wr rectified loads, the
-        // leaves' two factor loads each). Counted for no listed pixel (the common case):
-        // the count load.
-        counts: [0.0, 1.0, 0.0, 0.0, 4.0],
+        counts: [8.0, 3.0 + wr as f64 * 3.0, 0.0, 4.0, 40.0 + wr as f64 * 24.0],
         low: None,
-        trips: "listed pixels, data-dependent (none .. a few per cent of the screen)",
+        trips: "Wr columns per listed pixel; listed pixels data-dependent (none .. a few per cent of the screen)",
     });
     // area_ivsv at its defaults: 64 VPLs, 256 x 256 texels per VPL, 8 segments (the
     // interleaved sum at M = 2); its passes are measured by `examples/area_bench`, not the
@@ -740,14 +736,10 @@ fn sampled_costs(out: &mut Vec<KernelCost>, pixels: u64, n: f64) {
     out.push(KernelCost {
         method: "raymarch n64 ep512",
         kernel: "raymarch_unwarp",
-        invocations: pixels,
-        // The layout (two loads), the slices' lines (two), four samples and the pixel's
-        // depth; the pixel's angle (one atan2) and three divisions (counted as
-        // transcendentals); the taps' weights and the blend by depth and light (about 90
-        // FMAs); the rgba16float store (or a 4-byte list entry).
-        counts: [8.0, 9.0, 0.0, 4.0, 90.0],
+        invocations: w.div_ceil(2) * h.div_ceil(2),
+        counts: EPIPOLAR_UNWARP,
         low: None,
-        trips: "4 taps",
+        trips: "2 x 2 pixels x 4 taps",
     });
     let grid = lowres_grid(w, 2) * lowres_grid(h, 2);
     out.push(KernelCost {
@@ -771,26 +763,27 @@ fn sampled_costs(out: &mut Vec<KernelCost>, pixels: u64, n: f64) {
         trips: "S x S pixels x 4 taps",
     });
     for method in ["raymarch n64 ep512", "raymarch n64 lr2"] {
-        // One invocation per 8 x 8 pixels walks the list: per listed pixel one entry load
-        // and the per-pixel body. Counted for none listed .. 5 % of the pixels (3.2 per
-        // invocation; the headline lists 0.3-4 %).
-        let listed = 0.05 * 64.0;
+        // Dispatched indirectly, one invocation per listed pixel: the count and the entry,
+        // then the per-pixel body. Counted for 5 % of the pixels listed (the headline lists
+        // 0.3-4 %).
         out.push(KernelCost {
             method,
             kernel: "raymarch_fallback",
-            invocations: pixels.div_ceil(64),
-            counts: [
-                8.0 * listed,
-                1.0 + listed * (2.0 + n),
-                0.0,
-                listed * eval[3],
-                4.0 + listed * eval[4],
-            ],
-            low: Some([0.0, 1.0, 0.0, 0.0, 4.0]),
-            trips: "listed pixels, data-dependent (none .. 5 % of the screen)",
+            invocations: (pixels as f64 * 0.05) as u64,
+            counts: [8.0, 4.0 + n, 0.0, eval[3], 8.0 + eval[4]],
+            low: None,
+            trips: "N samples per listed pixel; listed pixels data-dependent (none .. 5 % of the screen)",
         });
     }
 }
+
+/// One invocation of the epipolar unwarp (every family's `<kernel>_unwarp`), a 2 x 2 block
+/// (`scatter_shaderlib::sampling::EPIPOLAR_UNWARP_BLOCK`): the layout (two loads), the two
+/// slices' lines, four sample loads and the four pixels' depths; the centre's angle (one
+/// atan2) and about six divisions (counted as transcendentals); per pixel its weights from
+/// the gradients and the blend by depth and light (about 90 FMAs); four rgba16float stores
+/// (or 4-byte list entries).
+const EPIPOLAR_UNWARP: [f64; 5] = [32.0, 12.0, 0.0, 7.0, 360.0];
 
 /// `ceil((side - 1) / scale) + 1`: the lowres grid along one axis.
 fn lowres_grid(side: u64, scale: u64) -> u64 {
