@@ -134,6 +134,10 @@ fn main() -> ExitCode {
                 for line in scatter_examples::bench::headline_lines(&r) {
                     println!("{line}");
                 }
+                // The machine's state around the timings (probes before, then after).
+                for probes in &r.probes {
+                    println!("{}", scatter_examples::roofline::bounds_markdown(probes));
+                }
                 if args.headline_errors {
                     for line in scatter_examples::bench::ratios(&r) {
                         println!("{line}");

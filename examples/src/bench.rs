@@ -471,6 +471,12 @@ pub struct BenchResult {
     pub skipped: Vec<(String, String)>,
     /// Wall time of the whole bench.
     pub elapsed: Duration,
+    /// The machine's bounds (`roofline::measure_bounds`: copy, texel loads, filtered fetches,
+    /// transcendentals, FMAs) measured just before and just after the run. lavapipe on a
+    /// shared machine moves between states that weigh these unevenly (docs/roofline.md, "Stop
+    /// 54": `prefilter` twice as long, raymarch faster, with the same binary), so a run
+    /// carries its own.
+    pub probes: [Vec<crate::roofline::Bound>; 2],
 }
 
 /// Any error of a bench run.
@@ -524,6 +530,8 @@ pub fn run(ctx: &Context, config: &BenchConfig, progress: bool) -> Result<BenchR
     } else {
         ProgressBar::hidden()
     };
+    bar.set_message("machine probes (before)");
+    let probes_before = crate::roofline::measure_bounds(ctx, PROBE_FRAMES)?;
     let mut rows = Vec::new();
     let mut skipped = Vec::new();
     let [w, h] = config.screen;
@@ -654,6 +662,8 @@ pub fn run(ctx: &Context, config: &BenchConfig, progress: bool) -> Result<BenchR
     } else {
         Vec::new()
     };
+    bar.set_message("machine probes (after)");
+    let probes_after = crate::roofline::measure_bounds(ctx, PROBE_FRAMES)?;
     bar.finish_and_clear();
     Ok(BenchResult {
         adapter: ctx.report().to_string(),
@@ -663,8 +673,12 @@ pub fn run(ctx: &Context, config: &BenchConfig, progress: bool) -> Result<BenchR
         headline,
         skipped,
         elapsed: start.elapsed(),
+        probes: [probes_before, probes_after],
     })
 }
+
+/// Timed frames of each machine probe a run records (about a second for the five).
+const PROBE_FRAMES: u32 = 5;
 
 /// Runs `method` once on a prepared scene (the engine's depth buffer `dv` and shadow map
 /// `sv` already uploaded; an area light's VPL maps ray-cast and uploaded here, as an engine
@@ -1707,6 +1721,14 @@ pub fn markdown(result: &BenchResult, command: &str) -> String {
         c.shadow_map,
         c.frames
     );
+    if !result.probes[0].is_empty() {
+        let _ = writeln!(
+            s,
+            "## Machine state\n\nThe probes of `bench --roofline` (docs/roofline.md) just before the run:\n\n{}\nand just after it:\n\n{}",
+            crate::roofline::bounds_markdown(&result.probes[0]),
+            crate::roofline::bounds_markdown(&result.probes[1])
+        );
+    }
     let _ = writeln!(s, "## Ratios (one run)\n");
     for r in ratios(result) {
         let _ = writeln!(s, "- {r}");
