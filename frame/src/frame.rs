@@ -635,12 +635,19 @@ fn prepare_frame_unchecked(
         "in [0, 1e6] pixels",
         || format!("{:?}", settings.epipole_radius_px),
     )?;
-    let min_width = variant.regions * variant.regions;
+    let min_width = variant.min_rectified_width();
     if res.rectified[0] < min_width {
         return Err(FrameError::RectifiedTooNarrow {
             width: res.rectified[0],
             regions: variant.regions,
+            stride: variant.filtered_stride,
             min: min_width,
+        });
+    }
+    if !res.rectified[0].is_multiple_of(variant.filtered_stride) {
+        return Err(FrameError::RectifiedStride {
+            width: res.rectified[0],
+            stride: variant.filtered_stride,
         });
     }
     let ScenePart {
@@ -916,6 +923,14 @@ pub fn region_start(r: u32, regions: u32, width: u32, spot: bool) -> u32 {
     }
 }
 
+/// First rectified column of region `r` when `prefilter` stores every `stride`-th column:
+/// `stride * region_start(r, regions, width / stride, spot)`, so regions start on multiples
+/// of the stride (WGSL: the callers of `region_start` in `prefilter.wgsl` and
+/// `common/prefiltered_projective.wgsl`). `stride = 1` is [`region_start`].
+pub fn region_column(r: u32, regions: u32, width: u32, stride: u32, spot: bool) -> u32 {
+    stride * region_start(r, regions, width / stride, spot)
+}
+
 /// The projective frame (Sec. 4.2): light space with the eye at the origin, `x` the
 /// bisectrix `e1` of the slices' fan, `y = e2`, `z` the axis towards the light. A point
 /// `q` maps to row `k = qy / qx`, ray depth `m = qz / qx` (constant along a view ray,
@@ -1051,8 +1066,10 @@ fn projective_frame(
         let pw = DVec4::new(1.0, 0.0, 0.0, 0.0);
         let proj = DMat4::from_cols(px, py, pz, pw).transpose();
         matrices.push(proj * view);
-        let b0 = region_start(r, regions, width, spot);
-        let b1 = region_start(r + 1, regions, width, spot);
+        // Regions start on multiples of the filtered stride (`region_column`).
+        let k = variant.filtered_stride;
+        let b0 = region_column(r, regions, width, k, spot);
+        let b1 = region_column(r + 1, regions, width, k, spot);
         viewports.push([b0, b1 - b0]);
     }
     let mut gv = [0.0f32; 12];

@@ -169,15 +169,27 @@ pub enum FrameError {
     },
     /// Too few rectified columns for the variant's regions.
     #[error(
-        "rectified width must be at least {min} for {regions} regions (every region needs a column), got {width}"
+        "rectified width must be at least {min} for {regions} regions and filtered_stride {stride} (every region needs a stored column: filtered_stride x regions^2), got {width}"
     )]
     RectifiedTooNarrow {
         /// The rectified width.
         width: u32,
         /// The variant's regions.
         regions: u32,
+        /// The variant's `filtered_stride`.
+        stride: u32,
         /// The smallest allowed width.
         min: u32,
+    },
+    /// A rectified width that the variant's `filtered_stride` does not divide.
+    #[error(
+        "rectified width must be a multiple of filtered_stride = {stride} (prefilter stores every {stride}-th column), got {width}"
+    )]
+    RectifiedStride {
+        /// The rectified width.
+        width: u32,
+        /// The variant's `filtered_stride`.
+        stride: u32,
     },
     /// A variant knob is out of range.
     #[error(transparent)]

@@ -230,6 +230,19 @@ pub struct PrefilteredVariant {
     /// more layer; `scatter` reconstructs each channel's lit share from them.
     #[serde(skip_serializing_if = "std::ops::Not::not")]
     pub cookie: bool,
+    /// Rectified columns per stored filtered column (1, 2, 4 or 8): `prefilter` still
+    /// filters every rectified texel of its row and region, but stores its running means
+    /// (and depth bounds) only at every k-th column's right edge, into a `filtered` map of
+    /// `rectified.width / k` columns; regions start on multiples of k. `scatter` reads that
+    /// map as one of k times wider columns. 1 (the default) is the paper's layout; the
+    /// rectified width must be a multiple of k. See `docs/roofline.md` ("coarse filtered
+    /// columns") for what it costs and saves.
+    #[serde(skip_serializing_if = "is_one")]
+    pub filtered_stride: u32,
+}
+
+fn is_one(v: &u32) -> bool {
+    *v == 1
 }
 
 impl Default for PrefilteredVariant {
@@ -252,6 +265,7 @@ impl Default for PrefilteredVariant {
             slice_samples: SamplingKnobs::DEFAULT_SLICE_SAMPLES,
             step: SamplingKnobs::DEFAULT_STEP,
             cookie: false,
+            filtered_stride: 1,
         }
     }
 }
@@ -263,6 +277,9 @@ impl PrefilteredVariant {
     pub const REGIONS: std::ops::RangeInclusive<u32> = 1..=8;
     /// Allowed `moments`.
     pub const MOMENTS: [u32; 2] = [4, 6];
+    /// Allowed `filtered_stride`: powers of two, so that a rectified column divided by the
+    /// stride is exact in `f32`.
+    pub const FILTERED_STRIDES: [u32; 4] = [1, 2, 4, 8];
     /// `moments` of [`PrefilteredVariant::with_moments`]'s callers that do not choose.
     pub const DEFAULT_MOMENTS: u32 = 4;
     /// The default `bases_per_thread`: 16 (the paper's Table 1 offers 4 .. 32). Measured on
@@ -371,6 +388,13 @@ impl PrefilteredVariant {
                 allowed: "in 1..=8".into(),
             });
         }
+        if !Self::FILTERED_STRIDES.contains(&self.filtered_stride) {
+            return Err(VariantError {
+                knob: "filtered_stride",
+                value: self.filtered_stride.to_string(),
+                allowed: "1, 2, 4 or 8".into(),
+            });
+        }
         self.sampling_knobs().validate()?;
         crate::cookie::validate_cookie(self.cookie, self.light)
     }
@@ -387,7 +411,8 @@ impl PrefilteredVariant {
     /// design card), every `bases_per_thread`, the given `regions`, both visibilities, both
     /// lights, every storage format and both rectifications; sorted by those knobs; then the
     /// moment basis; then the spot with a cookie (each basis, both visibilities and
-    /// rectifications, 3 regions where `regions` holds 3).
+    /// rectifications, 3 regions where `regions` holds 3), all with `filtered_stride = 1`;
+    /// then the coarse-column variants ([`Self::stride_grid`]).
     pub fn grid(regions: std::ops::RangeInclusive<u32>) -> Vec<PrefilteredVariant> {
         let mut out = Vec::new();
         for bases in [4, 8, 16, 32, 64, 128] {
@@ -455,6 +480,82 @@ impl PrefilteredVariant {
                 }
             }
         }
+        out.extend(Self::stride_grid(regions));
+        out
+    }
+
+    /// The rectified width the coarse-column variants of [`Self::grid`] are chosen for
+    /// (the conformance tests' map): every one has `filtered_stride * regions^2` at most
+    /// this.
+    pub const STRIDE_GRID_WIDTH: u32 = 64;
+
+    /// The coarse-column variants of [`Self::grid`]: every `filtered_stride` above 1 with
+    /// every light, rectification and visibility, each with five bases (m32-t16
+    /// rgba8unorm, m16-t8 rgba16float, m8-t4 rgba32float, 4 and 6 moments), the regions
+    /// cycling through those of `regions` that fit [`Self::STRIDE_GRID_WIDTH`]; then the
+    /// spot with its cookie (Fourier and 4 moments, both rectifications). Every knob value
+    /// meets every stride.
+    fn stride_grid(regions: std::ops::RangeInclusive<u32>) -> Vec<PrefilteredVariant> {
+        let bases = [
+            Self::default(),
+            Self {
+                bases: 16,
+                bases_per_thread: 8,
+                storage: Storage::Rgba16float,
+                ..Self::default()
+            },
+            Self {
+                bases: 8,
+                bases_per_thread: 4,
+                storage: Storage::Rgba32float,
+                ..Self::default()
+            },
+            Self::with_moments(4),
+            Self::with_moments(6),
+        ];
+        let mut out = Vec::new();
+        for k in Self::FILTERED_STRIDES.into_iter().filter(|&k| k > 1) {
+            let fits: Vec<u32> = regions
+                .clone()
+                .filter(|r| k * r * r <= Self::STRIDE_GRID_WIDTH)
+                .collect();
+            if fits.is_empty() {
+                continue;
+            }
+            let mut n = 0;
+            let mut next_regions = || {
+                n += 1;
+                fits[(n - 1) % fits.len()]
+            };
+            for &light in LightKind::SINGLE {
+                for &rectification in Rectification::ALL {
+                    for &visibility in VisibilityMode::ALL {
+                        for base in bases {
+                            out.push(PrefilteredVariant {
+                                regions: next_regions(),
+                                visibility,
+                                light,
+                                rectification,
+                                filtered_stride: k,
+                                ..base
+                            });
+                        }
+                    }
+                }
+            }
+            for base in [Self::default(), Self::with_moments(4)] {
+                for &rectification in Rectification::ALL {
+                    out.push(PrefilteredVariant {
+                        regions: next_regions(),
+                        light: LightKind::Spot,
+                        rectification,
+                        cookie: true,
+                        filtered_stride: k,
+                        ..base
+                    });
+                }
+            }
+        }
         out
     }
 
@@ -505,13 +606,36 @@ impl PrefilteredVariant {
         }
     }
 
+    /// The smallest rectified width for this variant: every region needs a stored
+    /// column, so `filtered_stride * regions^2` (the sun's quadratic region starts give the
+    /// first region `width / regions^2` columns).
+    pub fn min_rectified_width(&self) -> u32 {
+        self.filtered_stride * self.regions * self.regions
+    }
+
+    /// Columns of the `filtered` and `bounds` maps for a rectified width:
+    /// `width / filtered_stride`.
+    pub fn filtered_width(&self, rectified_width: u32) -> u32 {
+        rectified_width / self.filtered_stride.max(1)
+    }
+
+    /// `-stride{k}` for a `filtered_stride` other than 1, else empty.
+    fn stride_suffix(&self) -> String {
+        if self.filtered_stride == 1 {
+            String::new()
+        } else {
+            format!("-stride{}", self.filtered_stride)
+        }
+    }
+
     /// A short stable id, used in file names and trial names:
     /// `m32-t16-r3-weighted-directional-rgba8unorm-epipolar`,
-    /// `moments4-r3-weighted-directional-rgba32float-epipolar`, or with a cookie
-    /// `m32-t16-r3-weighted-spot-cookie-rgba8unorm-epipolar`.
+    /// `moments4-r3-weighted-directional-rgba32float-epipolar`, with a cookie
+    /// `m32-t16-r3-weighted-spot-cookie-rgba8unorm-epipolar`, with coarse filtered columns
+    /// `m32-t16-r3-weighted-directional-rgba8unorm-epipolar-stride4`.
     pub fn id(&self) -> String {
         format!(
-            "{}-r{}-{}-{}{}-{}-{}{}",
+            "{}-r{}-{}-{}{}-{}-{}{}{}",
             self.basis_id(),
             self.regions,
             self.visibility,
@@ -519,6 +643,7 @@ impl PrefilteredVariant {
             crate::cookie::id_suffix(self.cookie),
             self.storage,
             self.rectification,
+            self.stride_suffix(),
             self.sampling_knobs().id_suffix()
         )
     }
@@ -579,6 +704,7 @@ impl KnobSet for PrefilteredVariant {
             m += &format!("-{}", self.rectification);
         }
         m += crate::cookie::id_suffix(self.cookie);
+        m += &self.stride_suffix();
         m + &self.sampling_knobs().marker_suffix()
     }
 

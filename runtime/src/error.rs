@@ -99,18 +99,34 @@ pub enum RuntimeError {
     /// Too few rectified columns for the variant's prefix regions (the sun's regions split a
     /// row quadratically, so the first has `width / regions^2` columns).
     #[error(
-        "kernel `{kernel}`: regions = {regions} needs a rectified width of at least {min} \
-         columns (regions^2, so that every region has a column), got {width}"
+        "kernel `{kernel}`: regions = {regions} with filtered_stride = {stride} needs a \
+         rectified width of at least {min} columns (filtered_stride x regions^2, so that every \
+         region has a stored column), got {width}"
     )]
     TooFewColumns {
         /// The kernel.
         kernel: Kernel,
         /// Regions of the variant.
         regions: u32,
+        /// The variant's `filtered_stride`.
+        stride: u32,
         /// Rectified width.
         width: u32,
         /// Smallest allowed width.
         min: u32,
+    },
+    /// A rectified width that the variant's `filtered_stride` does not divide.
+    #[error(
+        "kernel `{kernel}`: the rectified width must be a multiple of filtered_stride = \
+         {stride} (prefilter stores every {stride}-th column), got {width}"
+    )]
+    StrideMismatch {
+        /// The kernel.
+        kernel: Kernel,
+        /// The variant's `filtered_stride`.
+        stride: u32,
+        /// Rectified width.
+        width: u32,
     },
     /// A texture handed to a pass has the wrong format or size.
     #[error("kernel `{kernel}`: {what} must be {expected}, got {actual}")]

@@ -171,16 +171,25 @@ impl Prefiltered {
             (RECTIFY, "shadow map", [shadow_map_size; 2]),
         ])?;
         // As `prepare_frame` requires: the first of the sun's quadratically split regions has
-        // `Wr / regions^2` columns.
-        let min_width = variant.regions * variant.regions;
+        // `Wr / (stride regions^2)` stored columns, and the stride divides the width.
+        let min_width = variant.min_rectified_width();
         if wr < min_width {
             return Err(RuntimeError::TooFewColumns {
                 kernel: PREFILTER,
                 regions: variant.regions,
+                stride: variant.filtered_stride,
                 width: wr,
                 min: min_width,
             });
         }
+        if !wr.is_multiple_of(variant.filtered_stride) {
+            return Err(RuntimeError::StrideMismatch {
+                kernel: PREFILTER,
+                stride: variant.filtered_stride,
+                width: wr,
+            });
+        }
+        let wc = variant.filtered_width(wr);
         let device = ctx.device();
         let limits = device.limits();
         check_texture_sides(
@@ -195,7 +204,7 @@ impl Prefiltered {
         )?;
         check_frame_buffers(&limits, hr)?;
         // The filtered bases: one storage-format texel per layer and rectified texel.
-        let filtered_bytes = u64::from(wr)
+        let filtered_bytes = u64::from(wc)
             * u64::from(hr)
             * u64::from(variant.filtered_layers())
             * u64::from(filtered_word_bytes(variant.storage));
@@ -208,15 +217,16 @@ impl Prefiltered {
         ] {
             check_limit(
                 PREFILTER,
-                "filtered-basis bytes (rectified width x height x layers x bytes per layer)",
+                "filtered-basis bytes (rectified width / filtered_stride x height x layers x \
+                 bytes per layer)",
                 filtered_bytes,
                 name,
                 limit,
             )?;
             check_limit(
                 PREFILTER,
-                "depth-bounds bytes (8 per rectified texel)",
-                u64::from(wr) * u64::from(hr) * 8,
+                "depth-bounds bytes (8 per stored column and rectified row)",
+                u64::from(wc) * u64::from(hr) * 8,
                 name,
                 limit,
             )?;
@@ -552,8 +562,9 @@ impl Prefiltered {
     }
 
     /// The filtered bases (written by `prefilter`): a storage buffer of
-    /// [`PrefilteredVariant::filtered_layers`] layers of `Wr x Hr` texels, layer `q` of texel
-    /// `(x, y)` at element `(q * Wr + x) * Hr + y` (rgba32float: `(q * Hr + y) * Wr + x`,
+    /// [`PrefilteredVariant::filtered_layers`] layers of `Wc x Hr` texels (`Wc = Wr /
+    /// filtered_stride`), layer `q` of texel
+    /// `(x, y)` at element `(q * Wc + x) * Hr + y` (rgba32float: `(q * Hr + y) * Wc + x`,
     /// `scatter_shaderlib::prefiltered::filtered_column_major`), each element the bits of one
     /// texel of the variant's storage format (Fourier bases as `F / 2 + 0.5` in [0, 1]).
     pub fn filtered_buffer(&self) -> &wgpu::Buffer {
@@ -561,7 +572,7 @@ impl Prefiltered {
     }
 
     /// The region-prefix depth bounds `prefilter` writes beside the filtered bases: a storage
-    /// buffer of `Wr x Hr` `vec2<f32>` (min, max), texel `(x, y)` at element `x * Hr + y`.
+    /// buffer of `Wc x Hr` `vec2<f32>` (min, max), texel `(x, y)` at element `x * Hr + y`.
     pub fn bounds_buffer(&self) -> &wgpu::Buffer {
         &self.bounds
     }
@@ -616,10 +627,11 @@ pub struct PrefilteredReadback {
     pub output: Vec<[f32; 4]>,
     /// Rectified map, `Wr * Hr` values, row-major.
     pub rectified: Vec<f32>,
-    /// Filtered bases, `Wr * Hr * filtered_layers` texels indexed `(layer * Hr + y) * Wr + x`,
+    /// Filtered bases, `Wc * Hr * filtered_layers` texels indexed `(layer * Hr + y) * Wc + x`
+    /// (`Wc = Wr / filtered_stride`, the stored columns),
     /// converted from the storage format to f32 (values in [0, 1]).
     pub filtered: Vec<[f32; 4]>,
-    /// Region-prefix depth bounds (min, max) per rectified texel, row-major.
+    /// Region-prefix depth bounds (min, max) per stored texel (`Wc x Hr`), row-major.
     pub bounds: Vec<[f32; 2]>,
     /// GPU time per pass, when the device has timestamps.
     pub gpu_times: Option<PrefilteredTimes>,
@@ -702,12 +714,10 @@ pub fn run_prefiltered_once(
         .chunks_exact(4)
         .map(|t| f32::from_le_bytes([t[0], t[1], t[2], t[3]]))
         .collect();
-    let filtered = filtered_layer_major(
-        &read_buffer(ctx, PREFILTER, &filtered)?,
-        variant,
-        res.rectified,
-    );
-    let bounds = bounds_row_major(&read_buffer(ctx, PREFILTER, &bounds)?, res.rectified);
+    // The stored columns: rectified.width / filtered_stride.
+    let stored = [variant.filtered_width(res.rectified[0]), res.rectified[1]];
+    let filtered = filtered_layer_major(&read_buffer(ctx, PREFILTER, &filtered)?, variant, stored);
+    let bounds = bounds_row_major(&read_buffer(ctx, PREFILTER, &bounds)?, stored);
     let output = output
         .read(ctx, SCATTER)?
         .chunks_exact(8)

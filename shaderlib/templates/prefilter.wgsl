@@ -51,8 +51,17 @@
 {%- if cookie %}
 // | 12      | cookie    | texture_2d<f32> (rgba, linear RGB)              | textureLoad  |
 {%- endif %}
-// filtered: Wr x Hr texels of {{ filtered_layers }} {{ storage }} layers each{% if !moments %} (bases / 4{% if cookie %} per channel, 3 channels, + 1{% endif %}){% endif %}, Wr x Hr = the rectified
-// size (frame.sizes.zw). bounds: Wr x Hr, (min, max) of the region's depths up to the texel (`bounds_index`).
+// filtered: Wc x Hr texels of {{ filtered_layers }} {{ storage }} layers each{% if !moments %} (bases / 4{% if cookie %} per channel, 3 channels, + 1{% endif %}){% endif %}, Wr x Hr = the rectified
+// size (frame.sizes.zw), Wc = Wr / {{ stride }} the stored columns. bounds: Wc x Hr, (min, max) of the region's depths up to the texel (`bounds_index`).
+{%- if stride > 1 %}
+//
+// Coarse filtered columns (filtered_stride = {{ stride }}): the loop filters every rectified texel
+// of its row and region, but stores the running means and bounds only at the right edge of
+// every {{ stride }}-th column (i % {{ stride }} = {{ stride }} - 1, into stored column i / {{ stride }}); regions start on multiples of {{ stride }}
+// (`region_column`), so every stored column belongs to one region. Stored column j holds
+// what one texel of a map with {{ stride }} times wider columns would hold had rectify averaged
+// its {{ stride }} light rays' bases rather than point-sampled one.
+{%- endif %}
 //
 // Dispatch: (ceil(Hr / 64), {{ regions }}, {{ threads_per_row_region }}) workgroups of (64, 1, 1);
 // invocation id x = row, y = region, z = thread.
@@ -61,11 +70,11 @@
 
 #import scatter::epipolar::{Frame, {% if cookie %}SliceParams, {% endif %}row_phi, slice_e, slice_params}
 {%- if moments %}
-#import scatter::prefiltered::{region_start, texel_weight}
+#import scatter::prefiltered::{region_column, texel_weight}
 #import scatter::moments::{moment_layer, moment_z}
 {%- else %}
 #import scatter::model::PI
-#import scatter::prefiltered::{basis4, fourier_step, region_start, texel_weight, turn}
+#import scatter::prefiltered::{basis4, fourier_step, region_column, texel_weight, turn}
 {%- endif %}
 {%- if projective %}
 #import scatter::projective::proj_stored_depth
@@ -111,7 +120,8 @@ fn texel_cookie(i: u32, slice: SliceParams, e: vec3<f32>, region: u32, proj: boo
     var l = -frame.axis.xyz * cos(col) + e * sin(col);
 {%- if projective %}
     if proj {
-        let g = proj_region_g(frame, f32(i) + 0.5, region, REGIONS, frame.sizes[2], true);
+        // The region layout of a map of Wr / STRIDE columns (`proj_texel_weight`).
+        let g = proj_region_g(frame, (f32(i) + 0.5) / f32(STRIDE), region, REGIONS, frame.sizes[2] / STRIDE, true);
         l = frame.e1_.xyz + frame.e2_.xyz * slice.delta - frame.axis.xyz * g;
     }
 {%- endif %}
@@ -140,8 +150,8 @@ fn prefilter(@builtin(global_invocation_id) id: vec3<u32>) {
     let slice = slice_params(slices[row]);
     // The row's slice direction (the spot weights' light rays, the cookie's).
     let e = slice_e(frame, row_phi(frame, row));
-    let start = region_start(region, REGIONS, width, spot);
-    let end = region_start(region + 1u, REGIONS, width, spot);
+    let start = region_column(region, REGIONS, width, STRIDE, spot);
+    let end = region_column(region + 1u, REGIONS, width, STRIDE, spot);
 {%- if cookie %}
     // Channel c's layer q of this thread at c * layers_per_thread + q.
     var acc: array<vec4<f32>, {{ acc_layers }}>;
@@ -162,7 +172,7 @@ fn prefilter(@builtin(global_invocation_id) id: vec3<u32>) {
         var w: f32;
         if proj {
             d = proj_stored_depth(d);
-            w = proj_texel_weight(frame, slice, i, region, REGIONS, weighted, spot);
+            w = proj_texel_weight(frame, slice, i, region, REGIONS, STRIDE, weighted, spot);
         } else {
             w = texel_weight(frame, slice, e, i, weighted, spot);
         }
@@ -171,17 +181,24 @@ fn prefilter(@builtin(global_invocation_id) id: vec3<u32>) {
         let w = texel_weight(frame, slice, e, i, weighted, spot);
 {%- endif %}
         wsum += w;
+        // Whether texel i ends a stored column (every texel with a stride of 1), and which.
+        let store = i % STRIDE == STRIDE - 1u;
+        let x = i / STRIDE;
         if thread == 0u {
             lo = min(lo, d);
             hi = max(hi, d);
-            bounds[bounds_index(i, row)] = vec2<f32>(lo, hi);
+            if store {
+                bounds[bounds_index(x, row)] = vec2<f32>(lo, hi);
+            }
         }
         let blend = select(0.0, w / wsum, wsum > 0.0);
 {%- if cookie %}
         let tint = texel_cookie(i, slice, e, region, proj);
         if thread == 0u {
             tint_mean = tint_mean * (1.0 - blend) + tint * blend;
-            filtered[filtered_index(i, row, 3u * LAYERS)] = encode_layer(vec4<f32>(tint_mean, 1.0));
+            if store {
+                filtered[filtered_index(x, row, 3u * LAYERS)] = encode_layer(vec4<f32>(tint_mean, 1.0));
+            }
         }
 {%- endif %}
 {%- if moments %}
@@ -193,11 +210,15 @@ fn prefilter(@builtin(global_invocation_id) id: vec3<u32>) {
             for (var c = 0u; c < 3u; c++) {
                 let slot = c * layers_per_thread + q;
                 acc[slot] = acc[slot] * (1.0 - blend) + b * (tint[c] * blend);
-                filtered[filtered_index(i, row, c * LAYERS + q)] = encode_layer(acc[slot]);
+                if store {
+                    filtered[filtered_index(x, row, c * LAYERS + q)] = encode_layer(acc[slot]);
+                }
             }
 {%- else %}
             acc[q] = acc[q] * (1.0 - blend) + moment_layer(z, q) * blend;
-            filtered[filtered_index(i, row, q)] = encode_layer(acc[q]);
+            if store {
+                filtered[filtered_index(x, row, q)] = encode_layer(acc[q]);
+            }
 {%- endif %}
         }
 {%- else %}
@@ -218,13 +239,17 @@ fn prefilter(@builtin(global_invocation_id) id: vec3<u32>) {
             for (var c = 0u; c < 3u; c++) {
                 let slot = c * layers_per_thread + q;
                 acc[slot] = acc[slot] * (1.0 - blend) + b * (tint[c] * blend);
-                filtered[filtered_index(i, row, c * LAYERS + layer)] = encode_layer(acc[slot] * 0.5 + 0.5);
+                if store {
+                    filtered[filtered_index(x, row, c * LAYERS + layer)] = encode_layer(acc[slot] * 0.5 + 0.5);
+                }
             }
 {%- else %}
             let a = acc[q];
             acc[q] = a * (1.0 - blend) + b * blend;
             let stored = acc[q] * 0.5 + 0.5;
-            filtered[filtered_index(i, row, layer)] = encode_layer(stored);
+            if store {
+                filtered[filtered_index(x, row, layer)] = encode_layer(stored);
+            }
 {%- endif %}
         }
 {%- endif %}

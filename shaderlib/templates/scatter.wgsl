@@ -56,14 +56,21 @@
 {%- if cookie %}
 // | 12      | cookie           | texture_2d<f32> (rgba, linear RGB)       | textureLoad        |
 {%- endif %}
-// filtered: Wr x Hr texels of {{ filtered_layers }} {{ storage }} layers each (below), Wr x Hr = the rectified
-// size (frame.sizes.zw), filtered by hand: linearly along each of the pixel's two rows, each row read at its own
+// filtered: Wc x Hr texels of {{ filtered_layers }} {{ storage }} layers each (below), Wr x Hr = the rectified
+// size (frame.sizes.zw), Wc = Wr / {{ stride }} the stored columns, filtered by hand: linearly along each of the pixel's two rows, each row read at its own
 // column for the ray (clamp-to-edge in u; in v wrapping round when the slices do,
 // frame.anti_epipole.w > 0.5, else clamp-to-edge), and the rows' estimates blended. Texel
 // loads instead of a filtering sampler measured 1.9x faster for the whole pass on lavapipe
 // (1280x720, sphere) and the weights are exact floats; a storage buffer in place of the
 // texture array that followed is faster still (below).
 //
+{%- if stride > 1 %}
+// Coarse filtered columns (filtered_stride = {{ stride }}): prefilter stored every {{ stride }}-th column's
+// running means, so the map is read as one of Wc columns, each {{ stride }} rectified columns (an
+// angle or a distance of {{ stride }} delta) wide; the linear lookup between the stored right edges
+// and the regions (starting on stored columns) are unchanged in those units.
+//
+{%- endif %}
 // Dispatch: (ceil(W / 8), ceil(H / 8), 1) workgroups of (8, 8, 1), W x H = screen size
 // (frame.sizes.xy); invocation id x = pixel column, y = pixel row.
 //
@@ -147,7 +154,8 @@ fn scatter_pixel(x: u32, y: u32) -> vec3<f32> {
     // Rectified coordinates of the surface point.
     let axis = f.axis.xyz;
     let rows = f.sizes[3];
-    let width = f.sizes[2];
+    // The stored columns (Wr / STRIDE), which the lookups below count in.
+    let width = f.sizes[2] / STRIDE;
     let regions = REGIONS;
     let wrap = f.anti_epipole[3] > 0.5;
     var yc: f32;
@@ -236,8 +244,9 @@ fn scatter_pixel(x: u32, y: u32) -> vec3<f32> {
 {%- else %}
     {
 {%- endif %}
-        delta0 = slice_params(slices[row0]).delta;
-        delta1 = slice_params(slices[row1]).delta;
+        // A stored column spans STRIDE rectified columns.
+        delta0 = f32(STRIDE) * slice_params(slices[row0]).delta;
+        delta1 = f32(STRIDE) * slice_params(slices[row1]).delta;
         xs0 = reach / delta0;
         xs1 = reach / delta1;
     }

@@ -16,8 +16,9 @@ use scatter_shaderlib::{BuiltKernel, Kernel, KernelParams, ShaderError, build, r
 
 /// Every valid variant: bases {4, .., 128} x every bases_per_thread x regions 1..=8 x
 /// visibility x light x storage x rectification, the moment basis (4 or 6 moments) x
-/// regions x visibility x light x rectification, and the spot's cookie (3 bases x visibility
-/// x rectification).
+/// regions x visibility x light x rectification, the spot's cookie (3 bases x visibility
+/// x rectification), and the coarse filtered columns (`filtered_stride` 2, 4, 8 x light x
+/// rectification x visibility x 5 bases, and 4 cookie variants each).
 fn cross_product() -> Vec<PrefilteredVariant> {
     PrefilteredVariant::grid(PrefilteredVariant::REGIONS)
 }
@@ -30,8 +31,9 @@ fn full_cross_product_validates() {
     let variants = cross_product();
     assert_eq!(
         variants.len(),
-        21 * 8 * 2 * 2 * 3 * 2 + 2 * 8 * 2 * 2 * 2 + 3 * 2 * 2,
-        "21 (bases, bases_per_thread) pairs; 2 moment counts (rgba32float only); cookies"
+        21 * 8 * 2 * 2 * 3 * 2 + 2 * 8 * 2 * 2 * 2 + 3 * 2 * 2 + 3 * (2 * 2 * 2 * 5 + 4),
+        "21 (bases, bases_per_thread) pairs; 2 moment counts (rgba32float only); cookies; \
+         filtered strides"
     );
     let start = Instant::now();
     // (kernel, rendered source) -> first parameter set that produced it.
@@ -76,10 +78,10 @@ fn full_cross_product_validates() {
     // Scatter: the Fourier layer counts (6 bases values) x the 3 storage formats (the
     // `filtered` buffer's element) and the 2 moment counts (rgba32float only), each x
     // regions x visibility x light x rectification; the cookie's 3 bases x visibility x
-    // rectification.
+    // rectification; every coarse-column variant (its stride is in the source).
     assert_eq!(
         per_kernel[&Kernel::Scatter],
-        (6 * 3 + 2) * 8 * 2 * 2 * 2 + 3 * 2 * 2
+        (6 * 3 + 2) * 8 * 2 * 2 * 2 + 3 * 2 * 2 + 3 * (2 * 2 * 2 * 5 + 4)
     );
     assert_eq!(per_kernel[&Kernel::Prefilter], variants.len());
     eprintln!(

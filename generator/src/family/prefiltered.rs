@@ -17,6 +17,8 @@ const BASES_PER_THREAD_ALLOWED: &str = "a multiple of 4 that divides bases";
 const REGIONS_ALLOWED: &str = "in 1..=8";
 /// Allowed `moments`.
 const MOMENTS_ALLOWED: &str = "4 or 6";
+/// Allowed `filtered_stride`.
+const FILTERED_STRIDE_ALLOWED: &str = "1, 2, 4 or 8";
 
 fn enum_allowed(allowed: &str) -> String {
     allowed.trim_end().replace(' ', " | ")
@@ -102,6 +104,17 @@ pub fn knobs() -> Vec<KnobInfo> {
             default: d.rectification.to_string(),
             value_type: KnobType::Name,
         },
+        KnobInfo {
+            name: "filtered_stride",
+            value_name: "K",
+            help: "rectified columns per stored filtered column: prefilter filters every \
+                   rectified texel but stores every K-th column's running means (regions start \
+                   on multiples of K; the rectified width must be a multiple of K), and scatter \
+                   reads a map K times coarser",
+            allowed: FILTERED_STRIDE_ALLOWED.into(),
+            default: d.filtered_stride.to_string(),
+            value_type: KnobType::Integer,
+        },
     ]
 }
 
@@ -142,6 +155,9 @@ pub fn parse(knobs: &[(String, String)]) -> Result<PrefilteredVariant, GenError>
                 storage_given = true;
             }
             "rectification" => v.rectification = value.parse()?,
+            "filtered_stride" => {
+                v.filtered_stride = number("filtered_stride", FILTERED_STRIDE_ALLOWED, value)?;
+            }
             other => {
                 return Err(GenError::Usage(format!(
                     "knob `{}` does not apply to family prefiltered",

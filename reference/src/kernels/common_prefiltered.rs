@@ -112,3 +112,10 @@ pub fn region_start(r: u32, regions: u32, width: u32, spot: bool) -> u32 {
         r * r * width / (regions * regions)
     }
 }
+
+/// First rectified column of region `r` when `prefilter` stores every `stride`-th column
+/// (coarse filtered columns): `stride` times the region's start in a row of `width / stride`
+/// columns, so regions start on multiples of the stride. `stride = 1` is [`region_start`].
+pub fn region_column(r: u32, regions: u32, width: u32, stride: u32, spot: bool) -> u32 {
+    stride * region_start(r, regions, width / stride, spot)
+}

@@ -46,7 +46,9 @@ pub fn proj_column(f: &FrameUniforms, g: f32, regions: u32, width: u32, spot: bo
 }
 
 /// Projective counterpart of [`texel_weight`] for column `i` of region `r`: the exact span
-/// of the row's reference ray that the texel covers (column 0 from the eye).
+/// of the row's reference ray that the texel covers (column 0 from the eye). With coarse
+/// filtered columns (`stride` > 1) the column invariant is that of column `i / stride` of a
+/// map of `width / stride` columns (see the WGSL comment).
 #[allow(clippy::too_many_arguments, reason = "mirrors the WGSL signature")]
 pub fn proj_texel_weight(
     f: &FrameUniforms,
@@ -54,10 +56,12 @@ pub fn proj_texel_weight(
     i: u32,
     r: u32,
     regions: u32,
+    stride: u32,
     weighted: bool,
     spot: bool,
 ) -> f32 {
-    let width = f.sizes[2];
+    let width = f.sizes[2] / stride;
+    let scale = 1.0 / stride as f32;
     let k = s.delta;
     let m = s.theta_ref;
     let len = sqrt(1.0 + k * k + m * m);
@@ -66,7 +70,7 @@ pub fn proj_texel_weight(
     if i > 0 {
         t0 = proj_reach(
             f,
-            proj_region_g(f, i as f32, r, regions, width, spot),
+            proj_region_g(f, i as f32 * scale, r, regions, width, spot),
             m,
             spot,
             cap / len,
@@ -74,7 +78,7 @@ pub fn proj_texel_weight(
     }
     let t1 = proj_reach(
         f,
-        proj_region_g(f, (i + 1) as f32, r, regions, width, spot),
+        proj_region_g(f, (i + 1) as f32 * scale, r, regions, width, spot),
         m,
         spot,
         cap / len,

@@ -6,7 +6,8 @@
 //! One invocation per (row, region, thread): thread `t` of a row-region filters the
 //! `bases_per_thread` bases of layers `t * bpt / 4 ..`. Each region restarts the running mean.
 //! Stored per texel: the normalised weighted mean `F_k = sum w_i B_k(d_i) / sum w_i` over the
-//! region up to the texel, mapped to [0, 1] as `F / 2 + 0.5` in the variant's storage format.
+//! region up to the texel (with `filtered_stride = k > 1` only at every k-th texel's right
+//! edge, into stored column `i / k`; regions start on multiples of k), mapped to [0, 1] as `F / 2 + 0.5` in the variant's storage format.
 //! `scatter` weights each region by the pixel's own unshadowed integral over the part of its
 //! ray inside the region, so no weight sums need to be stored. Thread 0 of a row-region also
 //! stores the least and the greatest depth over the region up to the texel (`bounds`,
@@ -28,7 +29,7 @@ use super::common_epipolar::{row_phi, slice_e};
 use super::common_model::PI;
 use super::common_model::select;
 use super::common_moments::{moment_layer, moment_z};
-use super::common_prefiltered::{basis4, fourier_step, region_start, texel_weight, turn};
+use super::common_prefiltered::{basis4, fourier_step, region_column, texel_weight, turn};
 use super::common_prefiltered_projective::{proj_region_g, proj_texel_weight};
 use super::common_projective::proj_stored_depth;
 use super::texture::{Tex, TexArray, xyz};
@@ -39,13 +40,14 @@ use scatter_shaderlib::prefiltered::{
 };
 
 /// The cookie of texel `i` of a row (slice `slice`, slice direction `e`; in a projective
-/// frame column `i` of region `region`): that of the light ray through the texel's centre
-/// (see the WGSL comment).
+/// frame column `i` of region `region`, with `stride` rectified columns per stored one): that
+/// of the light ray through the texel's centre (see the WGSL comment).
 #[allow(clippy::too_many_arguments, reason = "mirrors the WGSL signature")]
 pub fn texel_cookie(
     frame: &FrameUniforms,
     cookie: &TexArray,
     regions: u32,
+    stride: u32,
     i: u32,
     slice: &SliceParams,
     e: Vec3,
@@ -55,7 +57,15 @@ pub fn texel_cookie(
     let col = (i as f32 + 0.5) * slice.delta;
     let mut l = -xyz(frame.axis) * col.cos() + e * col.sin();
     if proj {
-        let g = proj_region_g(frame, i as f32 + 0.5, region, regions, frame.sizes[2], true);
+        // The region layout of a map of Wr / stride columns (`proj_texel_weight`).
+        let g = proj_region_g(
+            frame,
+            (i as f32 + 0.5) / stride as f32,
+            region,
+            regions,
+            frame.sizes[2] / stride,
+            true,
+        );
         l = xyz(frame.e1) + xyz(frame.e2) * slice.delta - xyz(frame.axis) * g;
     }
     frame_cookie(frame, cookie, xyz(frame.light_pos) + l)
@@ -88,8 +98,9 @@ pub fn prefilter_main(
     let moments = variant.basis == Basis::Moments;
     let layers_per_thread = variant.per_thread().div_ceil(4);
     let slice = slices[row as usize];
-    let start = region_start(region, variant.regions, width, spot);
-    let end = region_start(region + 1, variant.regions, width, spot);
+    let stride = variant.filtered_stride;
+    let start = region_column(region, variant.regions, width, stride, spot);
+    let end = region_column(region + 1, variant.regions, width, stride, spot);
     let tinted = variant.cookie;
     let layers = variant.layers();
     let e = slice_e(frame, row_phi(frame, row));
@@ -105,26 +116,52 @@ pub fn prefilter_main(
         let w;
         if proj {
             d = proj_stored_depth(d);
-            w = proj_texel_weight(frame, &slice, i, region, variant.regions, weighted, spot);
+            w = proj_texel_weight(
+                frame,
+                &slice,
+                i,
+                region,
+                variant.regions,
+                stride,
+                weighted,
+                spot,
+            );
         } else {
             w = texel_weight(frame, &slice, e, i, weighted, spot);
         }
         wsum += w;
+        // Whether texel i ends a stored column (every texel with a stride of 1), and which.
+        let store = i % stride == stride - 1;
+        let x = i / stride;
         if thread == 0 {
             lo = lo.min(d);
             hi = hi.max(d);
-            bounds.store(i, row, 0, [lo, hi, 0.0, 0.0], Storage::Rgba32float);
+            if store {
+                bounds.store(x, row, 0, [lo, hi, 0.0, 0.0], Storage::Rgba32float);
+            }
         }
         let blend = select(0.0, w / wsum, wsum > 0.0);
         let mut tint = Vec3::ONE;
         if tinted {
             if let Some(cookie) = cookie {
-                tint = texel_cookie(frame, cookie, variant.regions, i, &slice, e, region, proj);
+                tint = texel_cookie(
+                    frame,
+                    cookie,
+                    variant.regions,
+                    stride,
+                    i,
+                    &slice,
+                    e,
+                    region,
+                    proj,
+                );
             }
             if thread == 0 {
                 tint_mean = tint_mean * (1.0 - blend) + tint * blend;
                 let t = [tint_mean.x, tint_mean.y, tint_mean.z, 1.0];
-                filtered.store(i, row, 3 * layers, t, variant.storage);
+                if store {
+                    filtered.store(x, row, 3 * layers, t, variant.storage);
+                }
             }
         }
         // The running means of channel `c`'s `b` (the basis times the cookie; without a
@@ -147,7 +184,9 @@ pub fn prefilter_main(
                 let b = moment_layer(z, q);
                 for c in 0..channels {
                     let a = update(c, q, b);
-                    filtered.store(i, row, c * layers + q, a, variant.storage);
+                    if store {
+                        filtered.store(x, row, c * layers + q, a, variant.storage);
+                    }
                 }
             }
             continue;
@@ -171,7 +210,9 @@ pub fn prefilter_main(
                     a[2] * 0.5 + 0.5,
                     a[3] * 0.5 + 0.5,
                 ];
-                filtered.store(i, row, c * layers + layer, stored, variant.storage);
+                if store {
+                    filtered.store(x, row, c * layers + layer, stored, variant.storage);
+                }
             }
         }
     }
@@ -186,7 +227,8 @@ pub struct PrefilterOutput {
     pub bounds: TexArray,
 }
 
-/// Runs every invocation; returns the filtered-basis array and the region-prefix bounds.
+/// Runs every invocation; returns the filtered-basis array and the region-prefix bounds,
+/// both `Wr / filtered_stride` stored columns wide.
 /// `cookie`: the spot's cookie texture for a `cookie` variant (ignored otherwise; a `cookie`
 /// variant without one filters as with a white cookie).
 pub fn prefilter(
@@ -196,7 +238,8 @@ pub fn prefilter(
     rectified: &Tex,
     cookie: Option<&TexArray>,
 ) -> PrefilterOutput {
-    let (w, h) = (frame.sizes[2], frame.sizes[3]);
+    // The stored columns: Wr / filtered_stride.
+    let (w, h) = (variant.filtered_width(frame.sizes[2]), frame.sizes[3]);
     let mut filtered = TexArray::new(w, h, variant.filtered_layers());
     let mut bounds = TexArray::new(w, h, 1);
     for row in 0..h {

@@ -91,7 +91,9 @@ pub fn scatter_main(
     // Rectified coordinates of the surface point.
     let axis = xyz(f.axis);
     let rows = f.sizes[3];
-    let width = f.sizes[2];
+    // The stored columns (Wr / filtered_stride), which the lookups below count in.
+    let stride = variant.filtered_stride;
+    let width = f.sizes[2] / stride;
     let regions = variant.regions;
     let wrap = f.anti_epipole[3] > 0.5;
     let yc: f32;
@@ -171,8 +173,9 @@ pub fn scatter_main(
     let (mut delta0, mut delta1) = (1.0, 1.0);
     let (mut xs0, mut xs1) = (xs, xs);
     if !proj {
-        delta0 = inp.slices[row0 as usize].delta;
-        delta1 = inp.slices[row1 as usize].delta;
+        // A stored column spans `stride` rectified columns.
+        delta0 = stride as f32 * inp.slices[row0 as usize].delta;
+        delta1 = stride as f32 * inp.slices[row1 as usize].delta;
         xs0 = reach / delta0;
         xs1 = reach / delta1;
     }

@@ -110,6 +110,7 @@ struct PrefilterTemplate {
     filtered_layers: u32,
     cbar_layer: u32,
     acc_layers: u32,
+    stride: u32,
 }
 
 /// The askama views of `scatter.wgsl` and of the two epipolar passes that render it with
@@ -136,6 +137,7 @@ macro_rules! scatter_templates {
             cookie: bool,
             filtered_layers: u32,
             cbar_layer: u32,
+            stride: u32,
             sampling: SamplingView,
         }
 
@@ -158,6 +160,7 @@ macro_rules! scatter_templates {
                     cookie: variant.cookie,
                     filtered_layers: variant.filtered_layers(),
                     cbar_layer: 3 * variant.layers(),
+                    stride: variant.filtered_stride,
                     sampling: scatter_sampling_view(variant, kernel),
                 }
             }
@@ -244,6 +247,7 @@ pub(crate) fn render_prefilter(variant: &PrefilteredVariant) -> Result<String, S
         filtered_layers: variant.filtered_layers(),
         cbar_layer: 3 * variant.layers(),
         acc_layers: 3 * variant.per_thread().div_ceil(4),
+        stride: variant.filtered_stride,
     }
     .render()
     .map_err(render_error(Kernel::Prefilter))

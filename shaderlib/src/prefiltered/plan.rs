@@ -25,9 +25,22 @@ pub const PROJECTIVE_WITHOUT_SHADOW_MAP: &str = "the frame is projective and the
                                                  standard shadow map (the binding is not read \
                                                  then)";
 /// Elements of the region-prefix depth bounds written by `prefilter`: one `vec2<f32>` (min,
-/// max) per rectified texel, 32-bit so that the bound tests compare the very depths the filter
-/// saw.
-pub const BOUNDS_ELEMENTS: &str = "rectified.width * rectified.height";
+/// max) per stored column and rectified row ([`stored_width`]), 32-bit so that the bound
+/// tests compare the very depths the filter saw.
+pub fn bounds_elements(v: &PrefilteredVariant) -> Formula {
+    format!("{} * rectified.height", stored_width(v))
+}
+
+/// The columns `prefilter` stores per row: `rectified.width`, or with coarse filtered
+/// columns (`filtered_stride = k > 1`) `ceil(rectified.width / k)` (the width is a multiple
+/// of k, so the division is exact).
+pub fn stored_width(v: &PrefilteredVariant) -> Formula {
+    if v.filtered_stride == 1 {
+        "rectified.width".to_owned()
+    } else {
+        format!("ceil(rectified.width / {})", v.filtered_stride)
+    }
+}
 /// The engine's rasterised rectified map of projective variants.
 pub const RECTIFIED_RASTER: &str = "rectified_raster";
 
@@ -39,10 +52,19 @@ pub fn plan(v: &PrefilteredVariant) -> Plan {
             name: "rectified.width",
             description: "light rays per epipolar slice (columns of the rectified map), an \
                           engine choice (the demo uses 1024)",
-            constraint: format!(
-                "regions^2 = {}..=max_texture_dimension_2d",
-                v.regions * v.regions
-            ),
+            constraint: if v.filtered_stride == 1 {
+                format!(
+                    "regions^2 = {}..=max_texture_dimension_2d",
+                    v.regions * v.regions
+                )
+            } else {
+                format!(
+                    "a multiple of filtered_stride = {} in filtered_stride x regions^2 = \
+                     {}..=max_texture_dimension_2d",
+                    v.filtered_stride,
+                    v.min_rectified_width()
+                )
+            },
         },
         Parameter {
             name: "rectified.height",
@@ -88,7 +110,7 @@ pub fn plan(v: &PrefilteredVariant) -> Plan {
         Resource {
             kind: "storage_buffer",
             buffer: Some(BufferDesc {
-                elements: Some(BOUNDS_ELEMENTS.to_owned()),
+                elements: Some(bounds_elements(v)),
                 usage: vec!["storage", "copy_src"],
             }),
             ..scatter_resource(
@@ -159,6 +181,17 @@ pub fn plan(v: &PrefilteredVariant) -> Plan {
              and DX12 have it, GLSL ES 3.0 as packHalf2x16).",
         );
     }
+    if v.filtered_stride > 1 {
+        notes.push(
+            "Coarse filtered columns (filtered_stride = k > 1): rectify still writes every \
+             rectified column and prefilter filters every one of them, but filtered and bounds \
+             hold only every k-th column's running mean (at its right edge), \
+             rectified.width / k columns per row: in their layouts x counts the stored \
+             columns and rectified.width reads rectified.width / k; the rectified width must \
+             be a multiple of k, and in a projective \
+             frame the region viewports (FrameReport::projective) start on multiples of k.",
+        );
+    }
     if v.rectification == Rectification::Projective {
         notes.push(
             "Projective variant: the frame set-up decides per frame (FrameReport::rectification) \
@@ -180,8 +213,9 @@ pub fn plan(v: &PrefilteredVariant) -> Plan {
 /// The elements of the `filtered` storage buffer: one per layer of every rectified texel.
 pub fn filtered_elements(v: &PrefilteredVariant) -> Formula {
     format!(
-        "{} * rectified.width * rectified.height",
-        v.filtered_layers()
+        "{} * {} * rectified.height",
+        v.filtered_layers(),
+        stored_width(v)
     )
 }
 

@@ -69,6 +69,13 @@ fn region_start(r: u32, regions: u32, width: u32, spot: bool) -> u32 {
     return r * r * width / (regions * regions);
 }
 
+// First rectified column of region `r` when `prefilter` stores every `stride`-th column
+// (coarse filtered columns): regions start on multiples of the stride, at `stride` times the
+// region's start in a row of `width / stride` columns. `stride = 1` is `region_start`.
+fn region_column(r: u32, regions: u32, width: u32, stride: u32, spot: bool) -> u32 {
+    return stride * region_start(r, regions, width / stride, spot);
+}
+
 // Distance from the eye, along the slice's reference ray, of column edge `x` (continuous,
 // in columns), capped at four far-plane distances.
 fn ref_t(f: Frame, s: SliceParams, x: f32, spot: bool) -> f32 {

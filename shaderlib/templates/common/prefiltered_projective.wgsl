@@ -42,18 +42,22 @@ fn proj_column(f: Frame, g: f32, regions: u32, width: u32, spot: bool) -> f32 {
 // the row's reference ray (direction e1 + k e2 + m_ref axis) that the texel covers, from the
 // projective map itself (Klehm's Eq. 12 assumes a constant growth factor per texel; the
 // spans of a perspective map grow hyperbolically, so the exact spans are used instead).
-// Column 0 also covers the ray from the eye to the map's first light ray.
-fn proj_texel_weight(f: Frame, s: SliceParams, i: u32, r: u32, regions: u32, weighted: bool, spot: bool) -> f32 {
-    let width = f.sizes[2];
+// Column 0 also covers the ray from the eye to the map's first light ray. With coarse
+// filtered columns (`stride` > 1) the regions start on multiples of the stride
+// (`region_column`): the column invariant is that of column `i / stride` of a map of
+// `width / stride` columns (exact: the stride is a power of two).
+fn proj_texel_weight(f: Frame, s: SliceParams, i: u32, r: u32, regions: u32, stride: u32, weighted: bool, spot: bool) -> f32 {
+    let width = f.sizes[2] / stride;
+    let scale = 1.0 / f32(stride);
     let k = s.delta;
     let m = s.theta_ref;
     let len = sqrt(1.0 + k * k + m * m);
     let cap = 4.0 * f.theta[2];
     var t0 = 0.0;
     if i > 0u {
-        t0 = proj_reach(f, proj_region_g(f, f32(i), r, regions, width, spot), m, spot, cap / len) * len;
+        t0 = proj_reach(f, proj_region_g(f, f32(i) * scale, r, regions, width, spot), m, spot, cap / len) * len;
     }
-    let t1 = proj_reach(f, proj_region_g(f, f32(i + 1u), r, regions, width, spot), m, spot, cap / len) * len;
+    let t1 = proj_reach(f, proj_region_g(f, f32(i + 1u) * scale, r, regions, width, spot), m, spot, cap / len) * len;
     if !weighted {
         return t1 - t0;
     }

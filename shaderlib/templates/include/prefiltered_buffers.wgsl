@@ -1,7 +1,7 @@
 
 // `filtered` is a storage buffer, layer-major and, for 4- and 8-byte elements, column-major
-// within a layer: layer q of rectified texel (x, row) at (q * Wr + x) * Hr + row (rgba32float:
-// row-major, (q * Hr + row) * Wr + x), each element one {{ storage }} texel's bits
+// within a layer: layer q of stored texel (x, row) at (q * Wc + x) * Hr + row (rgba32float:
+// row-major, (q * Hr + row) * Wc + x), each element one {{ storage }} texel's bits
 {%- if storage == "rgba8unorm" %}
 // (pack4x8unorm: the rounding an rgba8unorm texture store does).
 {%- elif storage == "rgba16float" %}
@@ -18,7 +18,12 @@
 // 19.3-22.1 ms column-major against 9.7-10.6 row-major (its `scatter` 57-61 against 58-65;
 // m32-r4's rgba8unorm `scatter` 68-91 column-major against 70-97 row-major).
 
-// The index in `bounds` of rectified texel (x, row): column-major as `filtered`'s layers.
+// Rectified columns per stored column (the variant's `filtered_stride`): `prefilter` stores
+// its running means and bounds at the right edge of every {{ stride }}-th rectified column only, so
+// `filtered` and `bounds` hold Wc = Wr / STRIDE columns per row, and x below counts those.
+const STRIDE: u32 = {{ stride }}u;
+
+// The index in `bounds` of stored texel (x, row): column-major as `filtered`'s layers.
 // A storage buffer of vec2<f32> in place of an rg32float texture: `scatter` 68.5-93.5 ms
 // against 75.7-99.4 (m32-r4 per pixel, the three scenes, binaries alternated), its lowres 2
 // samples pass 25-34 against 30-38 (m32-r8); `prefilter` unchanged.
@@ -26,12 +31,12 @@ fn bounds_index(x: u32, row: u32) -> u32 {
     return x * frame.sizes[3] + row;
 }
 
-// The index in `filtered` of layer `layer` of rectified texel (x, row).
+// The index in `filtered` of layer `layer` of stored texel (x, row).
 fn filtered_index(x: u32, row: u32, layer: u32) -> u32 {
 {%- if storage == "rgba32float" %}
-    return (layer * frame.sizes[3] + row) * frame.sizes[2] + x;
+    return (layer * frame.sizes[3] + row) * (frame.sizes[2] / STRIDE) + x;
 {%- else %}
-    return (layer * frame.sizes[2] + x) * frame.sizes[3] + row;
+    return (layer * (frame.sizes[2] / STRIDE) + x) * frame.sizes[3] + row;
 {%- endif %}
 }
 {%- if storage == "rgba8unorm" %}
@@ -63,7 +68,7 @@ fn decode_layer(w: vec4<f32>) -> vec4<f32> {
 }
 {%- endif %}
 
-// Layer `layer` of rectified texel (x, row).
+// Layer `layer` of stored texel (x, row).
 fn filtered_load(x: u32, row: u32, layer: u32) -> vec4<f32> {
     return decode_layer(filtered[filtered_index(x, row, layer)]);
 }
