@@ -69,6 +69,38 @@ fn eval(formula: &str, sizes: &[(&str, u32)]) -> u32 {
     })
 }
 
+/// Coarse filtered columns: `filtered` and `bounds` hold `rectified.width / k` columns, and the
+/// manifest says so (the runtime sizes them from these formulas).
+#[test]
+fn manifest_sizes_coarse_filtered_columns() {
+    for k in [2, 4, 8] {
+        let v = PrefilteredVariant {
+            filtered_stride: k,
+            ..PrefilteredVariant::default()
+        };
+        let m = manifest(v);
+        let variant = &get(&m, "variants")[0];
+        let filtered = get(resource(variant, "filtered"), "buffer");
+        assert_eq!(
+            str_of(filtered, "size_bytes"),
+            format!(
+                "{} * {} * ceil(rectified.width / {k}) * rectified.height",
+                filtered_word_bytes(v.storage),
+                v.filtered_layers()
+            ),
+            "{}",
+            v.id()
+        );
+        let bounds = get(resource(variant, "bounds"), "buffer");
+        assert_eq!(
+            str_of(bounds, "size_bytes"),
+            format!("8 * ceil(rectified.width / {k}) * rectified.height"),
+            "{}",
+            v.id()
+        );
+    }
+}
+
 #[test]
 fn manifest_resources_match_the_runtime() {
     for (&storage, &rectification) in Storage::ALL.iter().zip(Rectification::ALL.iter().cycle()) {

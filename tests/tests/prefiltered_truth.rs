@@ -22,6 +22,10 @@
 //! with the reason in the frame report and the epipolar variant's exact output, everywhere
 //! else. Projective frames meet the same bars except the poses in [`PROJECTIVE_EXCEPTIONS`].
 //!
+//! Coarse filtered columns ([`coarse_filtered_columns_on_every_pose`], `filtered_stride` 2
+//! and 4): the same bars but for [`STRIDE_EXCEPTIONS`], at most 1 point above stride 1 on any
+//! pose and 0.5 on the mean (measured: +0.035 and +0.125 on the mean, +0.73 at most).
+//!
 //! Trials are named `prefiltered::<variant id>::<scene>::<pose>` in the report.
 
 use scatter_reference::buffers::{GBuffer, ShadowMap};
@@ -569,3 +573,113 @@ fn moment_basis_on_every_pose() {
     );
     assert!(failures.is_empty(), "{failures:#?}");
 }
+
+/// Coarse filtered columns (`filtered_stride` 2 and 4, default variant otherwise, 512 columns
+/// stored as 256 and 128) on every pose: each meets the family's bars (issue 3: 3 % sun,
+/// 5 % spot, or the bound of [`EXCEPTIONS`]), costs at most [`STRIDE_MAX_COST`] points of rel
+/// L1 on any pose against `filtered_stride = 1` (issue 14's per-pose bar for an
+/// approximation that buys speed), and at most [`STRIDE_MEAN_COST`] on the mean (issue 14's
+/// mean bar), with no NaN/Inf.
+#[test]
+fn coarse_filtered_columns_on_every_pose() {
+    let strides = [2, 4];
+    let mut sums = [0.0f64; 3];
+    let mut failures = Vec::new();
+    for (name, pose) in all_poses() {
+        let f = fixture(name, pose, MediumPreset::Default);
+        let light = light_of(name);
+        let key = format!("{name}/{pose}");
+        let family_bar = match EXCEPTIONS.iter().find(|x| x.0 == key) {
+            Some(&(_, _, bound, _)) => bound,
+            None if light == LightKind::Spot => 5.0,
+            None => 3.0,
+        };
+        let base = PrefilteredVariant {
+            light,
+            ..PrefilteredVariant::default()
+        };
+        let e1 = 100.0 * error(&f, &base);
+        sums[0] += e1;
+        let mut line = format!("{key}: stride 1 {e1:.3} %");
+        for (i, k) in strides.into_iter().enumerate() {
+            let variant = PrefilteredVariant {
+                filtered_stride: k,
+                ..base
+            };
+            let e = 100.0 * error(&f, &variant);
+            sums[i + 1] += e;
+            line += &format!(", stride {k} {e:.3} % ({:+.3})", e - e1);
+            let mut bar = family_bar;
+            if let Some(&(_, _, measured, bound, source)) =
+                STRIDE_EXCEPTIONS.iter().find(|x| x.0 == key && x.1 == k)
+            {
+                line += &format!(
+                    " (bar {family_bar} % missed: {source}; measured {measured} %, bound {bound} %)"
+                );
+                if e <= family_bar {
+                    failures.push(format!(
+                        "{} {key} now meets the {family_bar} % bar ({e:.3} %): remove it from \
+                         STRIDE_EXCEPTIONS",
+                        variant.id()
+                    ));
+                }
+                bar = bound;
+            }
+            if e > bar {
+                failures.push(format!("{} {key}: {e:.3} % > {bar} %", variant.id()));
+            }
+            if e - e1 > STRIDE_MAX_COST {
+                failures.push(format!(
+                    "{} {key}: {e:.3} % is {:.3} points above stride 1 (> {STRIDE_MAX_COST})",
+                    variant.id(),
+                    e - e1
+                ));
+            }
+        }
+        println!("{line}");
+    }
+    let means = sums.map(|s| s / 24.0);
+    println!(
+        "means over the 24 poses: stride 1 {:.3} %, stride 2 {:.3} %, stride 4 {:.3} %",
+        means[0], means[1], means[2]
+    );
+    for (i, k) in strides.into_iter().enumerate() {
+        if means[i + 1] - means[0] > STRIDE_MEAN_COST {
+            failures.push(format!(
+                "stride {k}: mean {:.3} % is {:.3} points above stride 1 (> {STRIDE_MEAN_COST})",
+                means[i + 1],
+                means[i + 1] - means[0]
+            ));
+        }
+    }
+    assert!(failures.is_empty(), "{failures:#?}");
+}
+
+/// The most rel L1 (in points) coarse filtered columns may add to one pose (issue 14's
+/// per-pose bar for sampling).
+const STRIDE_MAX_COST: f64 = 1.0;
+/// The most rel L1 (in points) coarse filtered columns may add to the 24 poses' mean (issue
+/// 14's mean bar).
+const STRIDE_MEAN_COST: f64 = 0.5;
+
+/// Poses where coarse filtered columns miss the family's bar that `filtered_stride = 1`
+/// meets: (scene/pose, stride, measured rel L1 in %, asserted bound in %, what the
+/// measurements say).
+const STRIDE_EXCEPTIONS: &[(&str, u32, f64, f64, &str)] = &[
+    (
+        "window/epipole_on_screen",
+        2,
+        3.14,
+        3.5,
+        "stride 1 is 2.91 %, 0.09 below the bar; the coarse lookup adds 0.24 points, the largest \
+         cost of the 24 poses at stride 2 (the next: columns/light_behind +0.09)",
+    ),
+    (
+        "window/epipole_on_screen",
+        4,
+        3.64,
+        4.0,
+        "stride 1 is 2.91 %; the coarse lookup adds 0.73 points, the largest cost of the 24 \
+         poses (the next: columns/light_behind +0.30)",
+    ),
+];

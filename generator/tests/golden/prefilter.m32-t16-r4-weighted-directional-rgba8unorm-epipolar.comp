@@ -59,6 +59,7 @@ const float PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = 3.1415927;
 const vec4 GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = vec4(-0.8611363, -0.33998105, 0.33998105, 0.8611363);
 const vec4 GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = vec4(0.34785485, 0.65214515, 0.65214515, 0.34785485);
 const float CONE_FLOORX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX = 0.001;
+const uint STRIDE = 1u;
 const uint REGIONS = 4u;
 const uint BASES_PER_THREAD = 16u;
 const uint THREADS_PER_ROW_REGION = 2u;
@@ -321,10 +322,15 @@ uint region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(uint r, uint 
     return (((r * r) * width) / (regions * regions));
 }
 
-float ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6, SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX s, float x_1, bool spot_1) {
+uint region_columnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(uint r_1, uint regions_1, uint width_1, uint stride, bool spot_1) {
+    uint _e6 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(r_1, regions_1, (width_1 / stride), spot_1);
+    return (stride * _e6);
+}
+
+float ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6, SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX s, float x_1, bool spot_2) {
     bool local_2 = false;
     float cap = (4.0 * f_6.theta.z);
-    if (spot_1) {
+    if (spot_2) {
         float psi = (x_1 * s.delta);
         float den = sin((s.theta_ref + psi));
         if (!((den <= 0.0001))) {
@@ -342,24 +348,24 @@ float ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_oil_mod
     }
 }
 
-float texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7, SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX s_1, vec3 e_1, uint i_1, bool weighted, bool spot_2) {
+float texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7, SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX s_1, vec3 e_1, uint i_1, bool weighted, bool spot_3) {
     float w = 0.0;
-    float _e5 = ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_7, s_1, float(i_1), spot_2);
-    float _e9 = ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_7, s_1, float((i_1 + 1u)), spot_2);
+    float _e5 = ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_7, s_1, float(i_1), spot_3);
+    float _e9 = ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_7, s_1, float((i_1 + 1u)), spot_3);
     if (!(weighted)) {
         return (_e9 - _e5);
     }
     float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_7.medium.x, _e5, _e9);
     w = _e15;
-    if (spot_2) {
+    if (spot_3) {
         float psi_1 = ((float(i_1) + 0.5) * s_1.delta);
         vec3 l_1 = ((-(f_7.axis.xyz) * cos(psi_1)) + (e_1 * sin(psi_1)));
         float den_1 = max(sin((s_1.theta_ref + psi_1)), 0.0001);
-        float r_1 = max(((f_7.axis.w * sin(s_1.theta_ref)) / den_1), 0.0001);
+        float r_2 = max(((f_7.axis.w * sin(s_1.theta_ref)) / den_1), 0.0001);
         float _e51 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(l_1, f_7.light_dir.xyz), f_7.light_pos.w, f_7.light_dir.w);
         float cone = max(_e51, CONE_FLOORX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX);
         float _e54 = w;
-        w = (_e54 * ((cone * exp((-(f_7.medium.x) * r_1))) / (r_1 * r_1)));
+        w = (_e54 * ((cone * exp((-(f_7.medium.x) * r_2))) / (r_2 * r_2)));
     }
     float _e64 = w;
     return _e64;
@@ -371,9 +377,9 @@ uint bounds_index(uint x_2, uint row_3) {
 }
 
 uint filtered_index(uint x_3, uint row_4, uint layer) {
-    uint _e5 = _group_0_binding_0_cs.sizes.z;
-    uint _e12 = _group_0_binding_0_cs.sizes.w;
-    return ((((layer * _e5) + x_3) * _e12) + row_4);
+    uint _e3 = _group_0_binding_0_cs.sizes.z;
+    uint _e14 = _group_0_binding_0_cs.sizes.w;
+    return ((((layer * (_e3 / STRIDE)) + x_3) * _e14) + row_4);
 }
 
 uint encode_layer(vec4 v_10) {
@@ -399,7 +405,7 @@ void main() {
     uint row_6 = id.x;
     uint region = id.y;
     uint thread = id.z;
-    uint width_1 = _group_0_binding_0_cs.sizes.z;
+    uint width_2 = _group_0_binding_0_cs.sizes.z;
     uint _e14 = _group_0_binding_0_cs.sizes.w;
     if (!((row_6 >= _e14))) {
         local = (region >= REGIONS);
@@ -422,100 +428,106 @@ void main() {
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e37 = _group_0_binding_0_cs;
     float _e38 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e37, row_6);
     vec3 _e39 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e35, _e38);
-    uint _e42 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(region, REGIONS, width_1, false);
-    uint _e46 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((region + 1u), REGIONS, width_1, false);
-    i = _e42;
+    uint _e43 = region_columnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(region, REGIONS, width_2, STRIDE, false);
+    uint _e48 = region_columnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((region + 1u), REGIONS, width_2, STRIDE, false);
+    i = _e43;
     bool loop_init_2 = true;
     while(true) {
         if (!loop_init_2) {
-            uint _e149 = i;
-            i = (_e149 + 1u);
+            uint _e157 = i;
+            i = (_e157 + 1u);
         }
         loop_init_2 = false;
-        uint _e48 = i;
-        if ((_e48 < _e46)) {
+        uint _e50 = i;
+        if ((_e50 < _e48)) {
         } else {
             break;
         }
         {
-            uint _e50 = i;
-            int _e54_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_2_cs) - 1);
-            vec4 _e54 = texelFetch(_group_0_binding_2_cs, clamp(ivec2(uvec2(_e50, row_6)), ivec2(0), textureSize(_group_0_binding_2_cs, _e54_clamped_lod) - ivec2(1)), _e54_clamped_lod);
-            float d_1 = _e54.x;
-            FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e57 = _group_0_binding_0_cs;
-            uint _e58 = i;
-            float _e60 = texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e57, _e33, _e39, _e58, true, false);
-            float _e62 = wsum;
-            wsum = (_e62 + _e60);
+            uint _e52 = i;
+            int _e56_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_2_cs) - 1);
+            vec4 _e56 = texelFetch(_group_0_binding_2_cs, clamp(ivec2(uvec2(_e52, row_6)), ivec2(0), textureSize(_group_0_binding_2_cs, _e56_clamped_lod) - ivec2(1)), _e56_clamped_lod);
+            float d_1 = _e56.x;
+            FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e59 = _group_0_binding_0_cs;
+            uint _e60 = i;
+            float _e62 = texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e59, _e33, _e39, _e60, true, false);
+            float _e64 = wsum;
+            wsum = (_e64 + _e62);
+            uint _e66 = i;
+            bool store = ((_e66 % STRIDE) == 0u);
+            uint _e71 = i;
+            uint x_9 = (_e71 / STRIDE);
             if ((thread == 0u)) {
-                float _e67 = lo;
-                lo = min(_e67, d_1);
-                float _e70 = hi;
-                hi = max(_e70, d_1);
-                uint _e72 = i;
-                uint _e73 = bounds_index(_e72, row_6);
-                float _e76 = lo;
-                float _e77 = hi;
-                _group_0_binding_4_cs[_e73] = vec2(_e76, _e77);
+                float _e77 = lo;
+                lo = min(_e77, d_1);
+                float _e80 = hi;
+                hi = max(_e80, d_1);
+                if (store) {
+                    uint _e82 = bounds_index(x_9, row_6);
+                    float _e85 = lo;
+                    float _e86 = hi;
+                    _group_0_binding_4_cs[_e82] = vec2(_e85, _e86);
+                }
             }
-            float _e79 = wsum;
-            float _e81 = wsum;
-            float blend = ((_e81 > 0.0) ? (_e60 / _e79) : 0.0);
+            float _e88 = wsum;
+            float _e90 = wsum;
+            float blend = ((_e90 > 0.0) ? (_e62 / _e88) : 0.0);
             angle = vec2(sin((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * d_1)), cos((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * d_1)));
-            vec2 _e94 = angle;
-            vec2 _e95 = fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e94);
+            vec2 _e103 = angle;
+            vec2 _e104 = fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e103);
             k = 0u;
             bool loop_init_3 = true;
             while(true) {
                 if (!loop_init_3) {
-                    uint _e107 = k;
-                    k = (_e107 + 1u);
+                    uint _e116 = k;
+                    k = (_e116 + 1u);
                 }
                 loop_init_3 = false;
-                uint _e98 = k;
-                if ((_e98 < ((2u * thread) * 4u))) {
+                uint _e107 = k;
+                if ((_e107 < ((2u * thread) * 4u))) {
                 } else {
                     break;
                 }
                 {
-                    vec2 _e104 = angle;
-                    vec2 _e105 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e104, _e95);
-                    angle = _e105;
+                    vec2 _e113 = angle;
+                    vec2 _e114 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e113, _e104);
+                    angle = _e114;
                 }
             }
             q = 0u;
             bool loop_init_4 = true;
             while(true) {
                 if (!loop_init_4) {
-                    uint _e146 = q;
-                    q = (_e146 + 1u);
+                    uint _e154 = q;
+                    q = (_e154 + 1u);
                 }
                 loop_init_4 = false;
-                uint _e111 = q;
-                if ((_e111 < 4u)) {
+                uint _e120 = q;
+                if ((_e120 < 4u)) {
                 } else {
                     break;
                 }
                 {
-                    uint _e114 = q;
-                    uint layer_2 = ((thread * 4u) + _e114);
-                    vec2 _e116 = angle;
-                    vec2 _e117 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e116, _e95);
-                    vec2 _e118 = angle;
-                    vec4 _e119 = basis4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e118, _e117);
-                    vec2 _e120 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e117, _e95);
-                    angle = _e120;
-                    uint _e122 = q;
-                    vec4 a_6 = acc[_e122];
-                    uint _e125 = q;
-                    acc[_e125] = ((a_6 * (1.0 - blend)) + (_e119 * blend));
-                    uint _e132 = q;
-                    vec4 _e134 = acc[_e132];
-                    vec4 stored = ((_e134 * 0.5) + vec4(0.5));
-                    uint _e140 = i;
-                    uint _e141 = filtered_index(_e140, row_6, layer_2);
-                    uint _e144 = encode_layer(stored);
-                    _group_0_binding_3_cs[_e141] = _e144;
+                    uint _e123 = q;
+                    uint layer_2 = ((thread * 4u) + _e123);
+                    vec2 _e125 = angle;
+                    vec2 _e126 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e125, _e104);
+                    vec2 _e127 = angle;
+                    vec4 _e128 = basis4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e127, _e126);
+                    vec2 _e129 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e126, _e104);
+                    angle = _e129;
+                    uint _e131 = q;
+                    vec4 a_6 = acc[_e131];
+                    uint _e134 = q;
+                    acc[_e134] = ((a_6 * (1.0 - blend)) + (_e128 * blend));
+                    uint _e141 = q;
+                    vec4 _e143 = acc[_e141];
+                    vec4 stored = ((_e143 * 0.5) + vec4(0.5));
+                    if (store) {
+                        uint _e149 = filtered_index(x_9, row_6, layer_2);
+                        uint _e152 = encode_layer(stored);
+                        _group_0_binding_3_cs[_e149] = _e152;
+                    }
                 }
             }
         }

@@ -58,6 +58,7 @@ static const float PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = 3.1415927;
 static const float4 GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = float4(-0.8611363, -0.33998105, 0.33998105, 0.8611363);
 static const float4 GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = float4(0.34785485, 0.65214515, 0.65214515, 0.34785485);
 static const float CONE_FLOORX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX = 0.001;
+static const uint STRIDE = 1u;
 static const uint REGIONS = 4u;
 static const uint BASES_PER_THREAD = 16u;
 static const uint THREADS_PER_ROW_REGION = 2u;
@@ -378,12 +379,18 @@ uint region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(uint r, uint 
     return naga_div(((r * r) * width), (regions * regions));
 }
 
-float ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6, SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX s, float x_1, bool spot_1)
+uint region_columnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(uint r_1, uint regions_1, uint width_1, uint stride, bool spot_1)
+{
+    const uint _e6 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(r_1, regions_1, naga_div(width_1, stride), spot_1);
+    return (stride * _e6);
+}
+
+float ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6, SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX s, float x_1, bool spot_2)
 {
     bool local_2 = (bool)0;
 
     float cap = (4.0 * f_6.theta.z);
-    if (spot_1) {
+    if (spot_2) {
         float psi = (x_1 * s.delta);
         float den = sin((s.theta_ref + psi));
         if (!((den <= 0.0001))) {
@@ -401,26 +408,26 @@ float ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_oil_mod
     }
 }
 
-float texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7, SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX s_1, float3 e_1, uint i_1, bool weighted, bool spot_2)
+float texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7, SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX s_1, float3 e_1, uint i_1, bool weighted, bool spot_3)
 {
     float w = (float)0;
 
-    const float _e5 = ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_7, s_1, float(i_1), spot_2);
-    const float _e9 = ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_7, s_1, float((i_1 + 1u)), spot_2);
+    const float _e5 = ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_7, s_1, float(i_1), spot_3);
+    const float _e9 = ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_7, s_1, float((i_1 + 1u)), spot_3);
     if (!(weighted)) {
         return (_e9 - _e5);
     }
     const float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_7.medium.x, _e5, _e9);
     w = _e15;
-    if (spot_2) {
+    if (spot_3) {
         float psi_1 = ((float(i_1) + 0.5) * s_1.delta);
         float3 l_1 = ((-(f_7.axis.xyz) * cos(psi_1)) + (e_1 * sin(psi_1)));
         float den_1 = max(sin((s_1.theta_ref + psi_1)), 0.0001);
-        float r_1 = max(((f_7.axis.w * sin(s_1.theta_ref)) / den_1), 0.0001);
+        float r_2 = max(((f_7.axis.w * sin(s_1.theta_ref)) / den_1), 0.0001);
         const float _e51 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(l_1, f_7.light_dir.xyz), f_7.light_pos.w, f_7.light_dir.w);
         float cone = max(_e51, CONE_FLOORX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX);
         float _e54 = w;
-        w = (_e54 * ((cone * exp((-(f_7.medium.x) * r_1))) / (r_1 * r_1)));
+        w = (_e54 * ((cone * exp((-(f_7.medium.x) * r_2))) / (r_2 * r_2)));
     }
     float _e64 = w;
     return _e64;
@@ -434,9 +441,9 @@ uint bounds_index(uint x_2, uint row_3)
 
 uint filtered_index(uint x_3, uint row_4, uint layer)
 {
-    uint _e5 = frame.sizes.z;
-    uint _e12 = frame.sizes.w;
-    return ((((layer * _e5) + x_3) * _e12) + row_4);
+    uint _e3 = frame.sizes.z;
+    uint _e14 = frame.sizes.w;
+    return ((((layer * naga_div(_e3, STRIDE)) + x_3) * _e14) + row_4);
 }
 
 uint encode_layer(float4 v_10)
@@ -457,6 +464,10 @@ float4 filtered_load(uint x_4, uint row_5, uint layer_1)
     return _e7;
 }
 
+uint naga_mod(uint lhs, uint rhs) {
+    return lhs % (rhs == 0u ? 1u : rhs);
+}
+
 [numthreads(64, 1, 1)]
 void prefilter(uint3 id : SV_DispatchThreadID)
 {
@@ -474,7 +485,7 @@ void prefilter(uint3 id : SV_DispatchThreadID)
     uint row_6 = id.x;
     uint region = id.y;
     uint thread = id.z;
-    uint width_1 = frame.sizes.z;
+    uint width_2 = frame.sizes.z;
     uint _e14 = frame.sizes.w;
     if (!((row_6 >= _e14))) {
         local = (region >= REGIONS);
@@ -497,50 +508,55 @@ void prefilter(uint3 id : SV_DispatchThreadID)
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e37 = frame;
     const float _e38 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e37, row_6);
     const float3 _e39 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e35, _e38);
-    const uint _e42 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(region, REGIONS, width_1, false);
-    const uint _e46 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((region + 1u), REGIONS, width_1, false);
-    i = _e42;
+    const uint _e43 = region_columnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(region, REGIONS, width_2, STRIDE, false);
+    const uint _e48 = region_columnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((region + 1u), REGIONS, width_2, STRIDE, false);
+    i = _e43;
     uint2 loop_bound_2 = uint2(4294967295u, 4294967295u);
     bool loop_init_2 = true;
     while(true) {
         if (all(loop_bound_2 == uint2(0u, 0u))) { break; }
         loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
         if (!loop_init_2) {
-            uint _e149 = i;
-            i = (_e149 + 1u);
+            uint _e157 = i;
+            i = (_e157 + 1u);
         }
         loop_init_2 = false;
-        uint _e48 = i;
-        if ((_e48 < _e46)) {
+        uint _e50 = i;
+        if ((_e50 < _e48)) {
         } else {
             break;
         }
         {
-            uint _e50 = i;
-            float4 _e54 = rectified.Load(int3(uint2(_e50, row_6), int(0)));
-            float d_1 = _e54.x;
-            FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e57 = frame;
-            uint _e58 = i;
-            const float _e60 = texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e57, _e33, _e39, _e58, true, false);
-            float _e62 = wsum;
-            wsum = (_e62 + _e60);
+            uint _e52 = i;
+            float4 _e56 = rectified.Load(int3(uint2(_e52, row_6), int(0)));
+            float d_1 = _e56.x;
+            FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e59 = frame;
+            uint _e60 = i;
+            const float _e62 = texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e59, _e33, _e39, _e60, true, false);
+            float _e64 = wsum;
+            wsum = (_e64 + _e62);
+            uint _e66 = i;
+            bool store = (naga_mod(_e66, STRIDE) == 0u);
+            uint _e71 = i;
+            uint x_9 = naga_div(_e71, STRIDE);
             if ((thread == 0u)) {
-                float _e67 = lo;
-                lo = min(_e67, d_1);
-                float _e70 = hi;
-                hi = max(_e70, d_1);
-                uint _e72 = i;
-                const uint _e73 = bounds_index(_e72, row_6);
-                float _e76 = lo;
-                float _e77 = hi;
-                bounds.Store2(_e73*8, asuint(float2(_e76, _e77)));
+                float _e77 = lo;
+                lo = min(_e77, d_1);
+                float _e80 = hi;
+                hi = max(_e80, d_1);
+                if (store) {
+                    const uint _e82 = bounds_index(x_9, row_6);
+                    float _e85 = lo;
+                    float _e86 = hi;
+                    bounds.Store2(_e82*8, asuint(float2(_e85, _e86)));
+                }
             }
-            float _e79 = wsum;
-            float _e81 = wsum;
-            float blend = ((_e81 > 0.0) ? (_e60 / _e79) : 0.0);
+            float _e88 = wsum;
+            float _e90 = wsum;
+            float blend = ((_e90 > 0.0) ? (_e62 / _e88) : 0.0);
             angle = float2(sin((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * d_1)), cos((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * d_1)));
-            float2 _e94 = angle;
-            const float2 _e95 = fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e94);
+            float2 _e103 = angle;
+            const float2 _e104 = fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e103);
             k = 0u;
             uint2 loop_bound_3 = uint2(4294967295u, 4294967295u);
             bool loop_init_3 = true;
@@ -548,19 +564,19 @@ void prefilter(uint3 id : SV_DispatchThreadID)
                 if (all(loop_bound_3 == uint2(0u, 0u))) { break; }
                 loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
                 if (!loop_init_3) {
-                    uint _e107 = k;
-                    k = (_e107 + 1u);
+                    uint _e116 = k;
+                    k = (_e116 + 1u);
                 }
                 loop_init_3 = false;
-                uint _e98 = k;
-                if ((_e98 < ((2u * thread) * 4u))) {
+                uint _e107 = k;
+                if ((_e107 < ((2u * thread) * 4u))) {
                 } else {
                     break;
                 }
                 {
-                    float2 _e104 = angle;
-                    const float2 _e105 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e104, _e95);
-                    angle = _e105;
+                    float2 _e113 = angle;
+                    const float2 _e114 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e113, _e104);
+                    angle = _e114;
                 }
             }
             q = 0u;
@@ -570,35 +586,36 @@ void prefilter(uint3 id : SV_DispatchThreadID)
                 if (all(loop_bound_4 == uint2(0u, 0u))) { break; }
                 loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
                 if (!loop_init_4) {
-                    uint _e146 = q;
-                    q = (_e146 + 1u);
+                    uint _e154 = q;
+                    q = (_e154 + 1u);
                 }
                 loop_init_4 = false;
-                uint _e111 = q;
-                if ((_e111 < 4u)) {
+                uint _e120 = q;
+                if ((_e120 < 4u)) {
                 } else {
                     break;
                 }
                 {
-                    uint _e114 = q;
-                    uint layer_2 = ((thread * 4u) + _e114);
-                    float2 _e116 = angle;
-                    const float2 _e117 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e116, _e95);
-                    float2 _e118 = angle;
-                    const float4 _e119 = basis4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e118, _e117);
-                    const float2 _e120 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e117, _e95);
-                    angle = _e120;
-                    uint _e122 = q;
-                    float4 a_6 = acc[min(uint(_e122), 3u)];
-                    uint _e125 = q;
-                    acc[min(uint(_e125), 3u)] = ((a_6 * (1.0 - blend)) + (_e119 * blend));
-                    uint _e132 = q;
-                    float4 _e134 = acc[min(uint(_e132), 3u)];
-                    float4 stored = ((_e134 * 0.5) + (0.5).xxxx);
-                    uint _e140 = i;
-                    const uint _e141 = filtered_index(_e140, row_6, layer_2);
-                    const uint _e144 = encode_layer(stored);
-                    filtered.Store(_e141*4, asuint(_e144));
+                    uint _e123 = q;
+                    uint layer_2 = ((thread * 4u) + _e123);
+                    float2 _e125 = angle;
+                    const float2 _e126 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e125, _e104);
+                    float2 _e127 = angle;
+                    const float4 _e128 = basis4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e127, _e126);
+                    const float2 _e129 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e126, _e104);
+                    angle = _e129;
+                    uint _e131 = q;
+                    float4 a_6 = acc[min(uint(_e131), 3u)];
+                    uint _e134 = q;
+                    acc[min(uint(_e134), 3u)] = ((a_6 * (1.0 - blend)) + (_e128 * blend));
+                    uint _e141 = q;
+                    float4 _e143 = acc[min(uint(_e141), 3u)];
+                    float4 stored = ((_e143 * 0.5) + (0.5).xxxx);
+                    if (store) {
+                        const uint _e149 = filtered_index(x_9, row_6, layer_2);
+                        const uint _e152 = encode_layer(stored);
+                        filtered.Store(_e149*4, asuint(_e152));
+                    }
                 }
             }
         }

@@ -72,6 +72,7 @@ constant float PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = 3.1415927;
 constant metal::float4 GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = metal::float4(-0.8611363, -0.33998105, 0.33998105, 0.8611363);
 constant metal::float4 GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = metal::float4(0.34785485, 0.65214515, 0.65214515, 0.34785485);
 constant float CONE_FLOORX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX = 0.001;
+constant uint STRIDE = 1u;
 constant uint REGIONS = 4u;
 constant uint BASES_PER_THREAD = 16u;
 constant uint THREADS_PER_ROW_REGION = 2u;
@@ -448,15 +449,26 @@ uint region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
     return naga_div((r * r) * width, regions * regions);
 }
 
+uint region_columnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
+    uint r_1,
+    uint regions_1,
+    uint width_1,
+    uint stride,
+    bool spot_1
+) {
+    uint _e6 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(r_1, regions_1, naga_div(width_1, stride), spot_1);
+    return stride * _e6;
+}
+
 float ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6,
     SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX s,
     float x_1,
-    bool spot_1
+    bool spot_2
 ) {
     bool local_2 = {};
     float cap = 4.0 * f_6.theta.z;
-    if (spot_1) {
+    if (spot_2) {
         float psi = x_1 * s.delta;
         float den = metal::sin(s.theta_ref + psi);
         if (!((den <= 0.0001))) {
@@ -480,25 +492,25 @@ float texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
     metal::float3 e_1,
     uint i_1,
     bool weighted,
-    bool spot_2
+    bool spot_3
 ) {
     float w = {};
-    float _e5 = ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_7, s_1, static_cast<float>(i_1), spot_2);
-    float _e9 = ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_7, s_1, static_cast<float>(i_1 + 1u), spot_2);
+    float _e5 = ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_7, s_1, static_cast<float>(i_1), spot_3);
+    float _e9 = ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_7, s_1, static_cast<float>(i_1 + 1u), spot_3);
     if (!(weighted)) {
         return _e9 - _e5;
     }
     float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_7.medium.x, _e5, _e9);
     w = _e15;
-    if (spot_2) {
+    if (spot_3) {
         float psi_1 = (static_cast<float>(i_1) + 0.5) * s_1.delta;
         metal::float3 l_1 = (-(f_7.axis.xyz) * metal::cos(psi_1)) + (e_1 * metal::sin(psi_1));
         float den_1 = metal::max(metal::sin(s_1.theta_ref + psi_1), 0.0001);
-        float r_1 = metal::max((f_7.axis.w * metal::sin(s_1.theta_ref)) / den_1, 0.0001);
+        float r_2 = metal::max((f_7.axis.w * metal::sin(s_1.theta_ref)) / den_1, 0.0001);
         float _e51 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(metal::dot(l_1, f_7.light_dir.xyz), f_7.light_pos.w, f_7.light_dir.w);
         float cone = metal::max(_e51, CONE_FLOORX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX);
         float _e54 = w;
-        w = _e54 * ((cone * metal::exp(-(f_7.medium.x) * r_1)) / (r_1 * r_1));
+        w = _e54 * ((cone * metal::exp(-(f_7.medium.x) * r_2)) / (r_2 * r_2));
     }
     float _e64 = w;
     return _e64;
@@ -519,9 +531,9 @@ uint filtered_index(
     uint layer,
     constant FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX& frame
 ) {
-    uint _e5 = frame.sizes.z;
-    uint _e12 = frame.sizes.w;
-    return (((layer * _e5) + x_3) * _e12) + row_4;
+    uint _e3 = frame.sizes.z;
+    uint _e14 = frame.sizes.w;
+    return (((layer * naga_div(_e3, STRIDE)) + x_3) * _e14) + row_4;
 }
 
 uint encode_layer(
@@ -549,6 +561,10 @@ metal::float4 filtered_load(
     metal::float4 _e7 = decode_layer(_e6);
     return _e7;
 }
+uint naga_mod(uint lhs, uint rhs) {
+    return lhs % metal::select(rhs, 1u, rhs == 0u);
+}
+
 
 struct prefilterInput {
 };
@@ -574,7 +590,7 @@ kernel void prefilter(
     uint row_6 = id.x;
     uint region = id.y;
     uint thread_ = id.z;
-    uint width_1 = frame.sizes.z;
+    uint width_2 = frame.sizes.z;
     uint _e14 = frame.sizes.w;
     if (!((row_6 >= _e14))) {
         local = region >= REGIONS;
@@ -597,51 +613,56 @@ kernel void prefilter(
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e37 = frame;
     float _e38 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e37, row_6);
     metal::float3 _e39 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e35, _e38);
-    uint _e42 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(region, REGIONS, width_1, false);
-    uint _e46 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(region + 1u, REGIONS, width_1, false);
-    i = _e42;
+    uint _e43 = region_columnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(region, REGIONS, width_2, STRIDE, false);
+    uint _e48 = region_columnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(region + 1u, REGIONS, width_2, STRIDE, false);
+    i = _e43;
     uint2 loop_bound_2 = uint2(4294967295u);
     bool loop_init_2 = true;
     while(true) {
         if (metal::all(loop_bound_2 == uint2(0u))) { break; }
         loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
         if (!loop_init_2) {
-            uint _e149 = i;
-            i = _e149 + 1u;
+            uint _e157 = i;
+            i = _e157 + 1u;
         }
         loop_init_2 = false;
-        uint _e48 = i;
-        if (_e48 < _e46) {
+        uint _e50 = i;
+        if (_e50 < _e48) {
         } else {
             break;
         }
         {
-            uint _e50 = i;
-            uint clamped_lod_e54 = metal::min(uint(0), rectified.get_num_mip_levels() - 1);
-            metal::float4 _e54 = rectified.read(metal::min(metal::uint2(metal::uint2(_e50, row_6)), metal::uint2(rectified.get_width(clamped_lod_e54), rectified.get_height(clamped_lod_e54)) - 1), clamped_lod_e54);
-            float d_1 = _e54.x;
-            FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e57 = frame;
-            uint _e58 = i;
-            float _e60 = texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e57, _e33, _e39, _e58, true, false);
-            float _e62 = wsum;
-            wsum = _e62 + _e60;
+            uint _e52 = i;
+            uint clamped_lod_e56 = metal::min(uint(0), rectified.get_num_mip_levels() - 1);
+            metal::float4 _e56 = rectified.read(metal::min(metal::uint2(metal::uint2(_e52, row_6)), metal::uint2(rectified.get_width(clamped_lod_e56), rectified.get_height(clamped_lod_e56)) - 1), clamped_lod_e56);
+            float d_1 = _e56.x;
+            FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e59 = frame;
+            uint _e60 = i;
+            float _e62 = texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e59, _e33, _e39, _e60, true, false);
+            float _e64 = wsum;
+            wsum = _e64 + _e62;
+            uint _e66 = i;
+            bool store = naga_mod(_e66, STRIDE) == 0u;
+            uint _e71 = i;
+            uint x_9 = naga_div(_e71, STRIDE);
             if (thread_ == 0u) {
-                float _e67 = lo;
-                lo = metal::min(_e67, d_1);
-                float _e70 = hi;
-                hi = metal::max(_e70, d_1);
-                uint _e72 = i;
-                uint _e73 = bounds_index(_e72, row_6, frame);
-                float _e76 = lo;
-                float _e77 = hi;
-                bounds[metal::min(unsigned(_e73), (_buffer_sizes.size4 - 0 - 8) / 8)] = metal::float2(_e76, _e77);
+                float _e77 = lo;
+                lo = metal::min(_e77, d_1);
+                float _e80 = hi;
+                hi = metal::max(_e80, d_1);
+                if (store) {
+                    uint _e82 = bounds_index(x_9, row_6, frame);
+                    float _e85 = lo;
+                    float _e86 = hi;
+                    bounds[metal::min(unsigned(_e82), (_buffer_sizes.size4 - 0 - 8) / 8)] = metal::float2(_e85, _e86);
+                }
             }
-            float _e79 = wsum;
-            float _e81 = wsum;
-            float blend = (_e81 > 0.0) ? (_e60 / _e79) : 0.0;
+            float _e88 = wsum;
+            float _e90 = wsum;
+            float blend = (_e90 > 0.0) ? (_e62 / _e88) : 0.0;
             angle = metal::float2(metal::sin(PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * d_1), metal::cos(PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * d_1));
-            metal::float2 _e94 = angle;
-            metal::float2 _e95 = fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e94);
+            metal::float2 _e103 = angle;
+            metal::float2 _e104 = fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e103);
             k = 0u;
             uint2 loop_bound_3 = uint2(4294967295u);
             bool loop_init_3 = true;
@@ -649,19 +670,19 @@ kernel void prefilter(
                 if (metal::all(loop_bound_3 == uint2(0u))) { break; }
                 loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
                 if (!loop_init_3) {
-                    uint _e107 = k;
-                    k = _e107 + 1u;
+                    uint _e116 = k;
+                    k = _e116 + 1u;
                 }
                 loop_init_3 = false;
-                uint _e98 = k;
-                if (_e98 < ((2u * thread_) * 4u)) {
+                uint _e107 = k;
+                if (_e107 < ((2u * thread_) * 4u)) {
                 } else {
                     break;
                 }
                 {
-                    metal::float2 _e104 = angle;
-                    metal::float2 _e105 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e104, _e95);
-                    angle = _e105;
+                    metal::float2 _e113 = angle;
+                    metal::float2 _e114 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e113, _e104);
+                    angle = _e114;
                 }
             }
             q = 0u;
@@ -671,35 +692,36 @@ kernel void prefilter(
                 if (metal::all(loop_bound_4 == uint2(0u))) { break; }
                 loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
                 if (!loop_init_4) {
-                    uint _e146 = q;
-                    q = _e146 + 1u;
+                    uint _e154 = q;
+                    q = _e154 + 1u;
                 }
                 loop_init_4 = false;
-                uint _e111 = q;
-                if (_e111 < 4u) {
+                uint _e120 = q;
+                if (_e120 < 4u) {
                 } else {
                     break;
                 }
                 {
-                    uint _e114 = q;
-                    uint layer_2 = (thread_ * 4u) + _e114;
-                    metal::float2 _e116 = angle;
-                    metal::float2 _e117 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e116, _e95);
-                    metal::float2 _e118 = angle;
-                    metal::float4 _e119 = basis4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e118, _e117);
-                    metal::float2 _e120 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e117, _e95);
-                    angle = _e120;
-                    uint _e122 = q;
-                    metal::float4 a_6 = acc.inner[metal::min(unsigned(_e122), 3u)];
-                    uint _e125 = q;
-                    acc.inner[metal::min(unsigned(_e125), 3u)] = (a_6 * (1.0 - blend)) + (_e119 * blend);
-                    uint _e132 = q;
-                    metal::float4 _e134 = acc.inner[metal::min(unsigned(_e132), 3u)];
-                    metal::float4 stored = (_e134 * 0.5) + metal::float4(0.5);
-                    uint _e140 = i;
-                    uint _e141 = filtered_index(_e140, row_6, layer_2, frame);
-                    uint _e144 = encode_layer(stored);
-                    filtered[metal::min(unsigned(_e141), (_buffer_sizes.size3 - 0 - 4) / 4)] = _e144;
+                    uint _e123 = q;
+                    uint layer_2 = (thread_ * 4u) + _e123;
+                    metal::float2 _e125 = angle;
+                    metal::float2 _e126 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e125, _e104);
+                    metal::float2 _e127 = angle;
+                    metal::float4 _e128 = basis4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e127, _e126);
+                    metal::float2 _e129 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e126, _e104);
+                    angle = _e129;
+                    uint _e131 = q;
+                    metal::float4 a_6 = acc.inner[metal::min(unsigned(_e131), 3u)];
+                    uint _e134 = q;
+                    acc.inner[metal::min(unsigned(_e134), 3u)] = (a_6 * (1.0 - blend)) + (_e128 * blend);
+                    uint _e141 = q;
+                    metal::float4 _e143 = acc.inner[metal::min(unsigned(_e141), 3u)];
+                    metal::float4 stored = (_e143 * 0.5) + metal::float4(0.5);
+                    if (store) {
+                        uint _e149 = filtered_index(x_9, row_6, layer_2, frame);
+                        uint _e152 = encode_layer(stored);
+                        filtered[metal::min(unsigned(_e149), (_buffer_sizes.size3 - 0 - 4) / 4)] = _e152;
+                    }
                 }
             }
         }

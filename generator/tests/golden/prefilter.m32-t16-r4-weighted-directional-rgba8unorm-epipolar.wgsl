@@ -58,6 +58,7 @@ const PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX: f32 = 3.1415927f;
 const GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX: vec4<f32> = vec4<f32>(-0.8611363f, -0.33998105f, 0.33998105f, 0.8611363f);
 const GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX: vec4<f32> = vec4<f32>(0.34785485f, 0.65214515f, 0.65214515f, 0.34785485f);
 const CONE_FLOORX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX: f32 = 0.001f;
+const STRIDE: u32 = 1u;
 const REGIONS: u32 = 4u;
 const BASES_PER_THREAD: u32 = 16u;
 const THREADS_PER_ROW_REGION: u32 = 2u;
@@ -316,11 +317,16 @@ fn region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(r: u32, regions
     return (((r * r) * width) / (regions * regions));
 }
 
-fn ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_6: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, s: SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_1: f32, spot_1: bool) -> f32 {
+fn region_columnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(r_1: u32, regions_1: u32, width_1: u32, stride: u32, spot_1: bool) -> u32 {
+    let _e6 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(r_1, regions_1, (width_1 / stride), spot_1);
+    return (stride * _e6);
+}
+
+fn ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_6: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, s: SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_1: f32, spot_2: bool) -> f32 {
     var local_2: bool;
 
     let cap = (4f * f_6.theta.z);
-    if spot_1 {
+    if spot_2 {
         let psi = (x_1 * s.delta);
         let den = sin((s.theta_ref + psi));
         if !((den <= 0.0001f)) {
@@ -338,25 +344,25 @@ fn ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_6: FrameX_naga_oil_m
     }
 }
 
-fn texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_7: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, s_1: SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, e_1: vec3<f32>, i_1: u32, weighted: bool, spot_2: bool) -> f32 {
+fn texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_7: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, s_1: SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, e_1: vec3<f32>, i_1: u32, weighted: bool, spot_3: bool) -> f32 {
     var w: f32;
 
-    let _e5 = ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_7, s_1, f32(i_1), spot_2);
-    let _e9 = ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_7, s_1, f32((i_1 + 1u)), spot_2);
+    let _e5 = ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_7, s_1, f32(i_1), spot_3);
+    let _e9 = ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_7, s_1, f32((i_1 + 1u)), spot_3);
     if !(weighted) {
         return (_e9 - _e5);
     }
     let _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_7.medium.x, _e5, _e9);
     w = _e15;
-    if spot_2 {
+    if spot_3 {
         let psi_1 = ((f32(i_1) + 0.5f) * s_1.delta);
         let l_1 = ((-(f_7.axis.xyz) * cos(psi_1)) + (e_1 * sin(psi_1)));
         let den_1 = max(sin((s_1.theta_ref + psi_1)), 0.0001f);
-        let r_1 = max(((f_7.axis.w * sin(s_1.theta_ref)) / den_1), 0.0001f);
+        let r_2 = max(((f_7.axis.w * sin(s_1.theta_ref)) / den_1), 0.0001f);
         let _e51 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(l_1, f_7.light_dir.xyz), f_7.light_pos.w, f_7.light_dir.w);
         let cone = max(_e51, CONE_FLOORX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX);
         let _e54 = w;
-        w = (_e54 * ((cone * exp((-(f_7.medium.x) * r_1))) / (r_1 * r_1)));
+        w = (_e54 * ((cone * exp((-(f_7.medium.x) * r_2))) / (r_2 * r_2)));
     }
     let _e64 = w;
     return _e64;
@@ -368,9 +374,9 @@ fn bounds_index(x_2: u32, row_3: u32) -> u32 {
 }
 
 fn filtered_index(x_3: u32, row_4: u32, layer: u32) -> u32 {
-    let _e5 = frame.sizes.z;
-    let _e12 = frame.sizes.w;
-    return ((((layer * _e5) + x_3) * _e12) + row_4);
+    let _e3 = frame.sizes.z;
+    let _e14 = frame.sizes.w;
+    return ((((layer * (_e3 / STRIDE)) + x_3) * _e14) + row_4);
 }
 
 fn encode_layer(v_10: vec4<f32>) -> u32 {
@@ -404,7 +410,7 @@ fn prefilter(@builtin(global_invocation_id) id: vec3<u32>) {
     let row_6 = id.x;
     let region = id.y;
     let thread = id.z;
-    let width_1 = frame.sizes.z;
+    let width_2 = frame.sizes.z;
     let _e14 = frame.sizes.w;
     if !((row_6 >= _e14)) {
         local = (region >= REGIONS);
@@ -427,95 +433,101 @@ fn prefilter(@builtin(global_invocation_id) id: vec3<u32>) {
     let _e37 = frame;
     let _e38 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e37, row_6);
     let _e39 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e35, _e38);
-    let _e42 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(region, REGIONS, width_1, false);
-    let _e46 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((region + 1u), REGIONS, width_1, false);
-    i = _e42;
+    let _e43 = region_columnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(region, REGIONS, width_2, STRIDE, false);
+    let _e48 = region_columnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((region + 1u), REGIONS, width_2, STRIDE, false);
+    i = _e43;
     loop {
-        let _e48 = i;
-        if (_e48 < _e46) {
+        let _e50 = i;
+        if (_e50 < _e48) {
         } else {
             break;
         }
         {
-            let _e50 = i;
-            let _e54 = textureLoad(rectified, vec2<u32>(_e50, row_6), 0i);
-            let d_1 = _e54.x;
-            let _e57 = frame;
-            let _e58 = i;
-            let _e60 = texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e57, _e33, _e39, _e58, true, false);
-            let _e62 = wsum;
-            wsum = (_e62 + _e60);
+            let _e52 = i;
+            let _e56 = textureLoad(rectified, vec2<u32>(_e52, row_6), 0i);
+            let d_1 = _e56.x;
+            let _e59 = frame;
+            let _e60 = i;
+            let _e62 = texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e59, _e33, _e39, _e60, true, false);
+            let _e64 = wsum;
+            wsum = (_e64 + _e62);
+            let _e66 = i;
+            let store = ((_e66 % STRIDE) == 0u);
+            let _e71 = i;
+            let x_9 = (_e71 / STRIDE);
             if (thread == 0u) {
-                let _e67 = lo;
-                lo = min(_e67, d_1);
-                let _e70 = hi;
-                hi = max(_e70, d_1);
-                let _e72 = i;
-                let _e73 = bounds_index(_e72, row_6);
-                let _e76 = lo;
-                let _e77 = hi;
-                bounds[_e73] = vec2<f32>(_e76, _e77);
+                let _e77 = lo;
+                lo = min(_e77, d_1);
+                let _e80 = hi;
+                hi = max(_e80, d_1);
+                if store {
+                    let _e82 = bounds_index(x_9, row_6);
+                    let _e85 = lo;
+                    let _e86 = hi;
+                    bounds[_e82] = vec2<f32>(_e85, _e86);
+                }
             }
-            let _e79 = wsum;
-            let _e81 = wsum;
-            let blend = select(0f, (_e60 / _e79), (_e81 > 0f));
+            let _e88 = wsum;
+            let _e90 = wsum;
+            let blend = select(0f, (_e62 / _e88), (_e90 > 0f));
             angle = vec2<f32>(sin((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * d_1)), cos((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * d_1)));
-            let _e94 = angle;
-            let _e95 = fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e94);
+            let _e103 = angle;
+            let _e104 = fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e103);
             k = 0u;
             loop {
-                let _e98 = k;
-                if (_e98 < ((2u * thread) * 4u)) {
+                let _e107 = k;
+                if (_e107 < ((2u * thread) * 4u)) {
                 } else {
                     break;
                 }
                 {
-                    let _e104 = angle;
-                    let _e105 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e104, _e95);
-                    angle = _e105;
+                    let _e113 = angle;
+                    let _e114 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e113, _e104);
+                    angle = _e114;
                 }
                 continuing {
-                    let _e107 = k;
-                    k = (_e107 + 1u);
+                    let _e116 = k;
+                    k = (_e116 + 1u);
                 }
             }
             q = 0u;
             loop {
-                let _e111 = q;
-                if (_e111 < 4u) {
+                let _e120 = q;
+                if (_e120 < 4u) {
                 } else {
                     break;
                 }
                 {
-                    let _e114 = q;
-                    let layer_2 = ((thread * 4u) + _e114);
-                    let _e116 = angle;
-                    let _e117 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e116, _e95);
-                    let _e118 = angle;
-                    let _e119 = basis4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e118, _e117);
-                    let _e120 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e117, _e95);
-                    angle = _e120;
-                    let _e122 = q;
-                    let a_6 = acc[_e122];
-                    let _e125 = q;
-                    acc[_e125] = ((a_6 * (1f - blend)) + (_e119 * blend));
-                    let _e132 = q;
-                    let _e134 = acc[_e132];
-                    let stored = ((_e134 * 0.5f) + vec4(0.5f));
-                    let _e140 = i;
-                    let _e141 = filtered_index(_e140, row_6, layer_2);
-                    let _e144 = encode_layer(stored);
-                    filtered[_e141] = _e144;
+                    let _e123 = q;
+                    let layer_2 = ((thread * 4u) + _e123);
+                    let _e125 = angle;
+                    let _e126 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e125, _e104);
+                    let _e127 = angle;
+                    let _e128 = basis4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e127, _e126);
+                    let _e129 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e126, _e104);
+                    angle = _e129;
+                    let _e131 = q;
+                    let a_6 = acc[_e131];
+                    let _e134 = q;
+                    acc[_e134] = ((a_6 * (1f - blend)) + (_e128 * blend));
+                    let _e141 = q;
+                    let _e143 = acc[_e141];
+                    let stored = ((_e143 * 0.5f) + vec4(0.5f));
+                    if store {
+                        let _e149 = filtered_index(x_9, row_6, layer_2);
+                        let _e152 = encode_layer(stored);
+                        filtered[_e149] = _e152;
+                    }
                 }
                 continuing {
-                    let _e146 = q;
-                    q = (_e146 + 1u);
+                    let _e154 = q;
+                    q = (_e154 + 1u);
                 }
             }
         }
         continuing {
-            let _e149 = i;
-            i = (_e149 + 1u);
+            let _e157 = i;
+            i = (_e157 + 1u);
         }
     }
     return;

@@ -59,6 +59,7 @@ const float PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = 3.1415927;
 const vec4 GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = vec4(-0.8611363, -0.33998105, 0.33998105, 0.8611363);
 const vec4 GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = vec4(0.34785485, 0.65214515, 0.65214515, 0.34785485);
 const float CONE_FLOORX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX = 0.001;
+const uint STRIDE = 1u;
 const uint REGIONS = 4u;
 const uint BASES_PER_THREAD = 6u;
 const uint THREADS_PER_ROW_REGION = 1u;
@@ -309,10 +310,15 @@ uint region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(uint r, uint 
     return (((r * r) * width) / (regions * regions));
 }
 
-float ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6, SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX s, float x_1, bool spot_1) {
+uint region_columnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(uint r_1, uint regions_1, uint width_1, uint stride, bool spot_1) {
+    uint _e6 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(r_1, regions_1, (width_1 / stride), spot_1);
+    return (stride * _e6);
+}
+
+float ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6, SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX s, float x_1, bool spot_2) {
     bool local_2 = false;
     float cap = (4.0 * f_6.theta.z);
-    if (spot_1) {
+    if (spot_2) {
         float psi = (x_1 * s.delta);
         float den = sin((s.theta_ref + psi));
         if (!((den <= 0.0001))) {
@@ -330,24 +336,24 @@ float ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_oil_mod
     }
 }
 
-float texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7, SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX s_1, vec3 e_1, uint i_1, bool weighted, bool spot_2) {
+float texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7, SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX s_1, vec3 e_1, uint i_1, bool weighted, bool spot_3) {
     float w = 0.0;
-    float _e5 = ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_7, s_1, float(i_1), spot_2);
-    float _e9 = ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_7, s_1, float((i_1 + 1u)), spot_2);
+    float _e5 = ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_7, s_1, float(i_1), spot_3);
+    float _e9 = ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_7, s_1, float((i_1 + 1u)), spot_3);
     if (!(weighted)) {
         return (_e9 - _e5);
     }
     float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_7.medium.x, _e5, _e9);
     w = _e15;
-    if (spot_2) {
+    if (spot_3) {
         float psi_1 = ((float(i_1) + 0.5) * s_1.delta);
         vec3 l_1 = ((-(f_7.axis.xyz) * cos(psi_1)) + (e_1 * sin(psi_1)));
         float den_1 = max(sin((s_1.theta_ref + psi_1)), 0.0001);
-        float r_1 = max(((f_7.axis.w * sin(s_1.theta_ref)) / den_1), 0.0001);
+        float r_2 = max(((f_7.axis.w * sin(s_1.theta_ref)) / den_1), 0.0001);
         float _e51 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(l_1, f_7.light_dir.xyz), f_7.light_pos.w, f_7.light_dir.w);
         float cone = max(_e51, CONE_FLOORX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX);
         float _e54 = w;
-        w = (_e54 * ((cone * exp((-(f_7.medium.x) * r_1))) / (r_1 * r_1)));
+        w = (_e54 * ((cone * exp((-(f_7.medium.x) * r_2))) / (r_2 * r_2)));
     }
     float _e64 = w;
     return _e64;
@@ -373,8 +379,8 @@ uint bounds_index(uint x_2, uint row_3) {
 
 uint filtered_index(uint x_3, uint row_4, uint layer_1) {
     uint _e5 = _group_0_binding_0_cs.sizes.w;
-    uint _e12 = _group_0_binding_0_cs.sizes.z;
-    return ((((layer_1 * _e5) + row_4) * _e12) + x_3);
+    uint _e11 = _group_0_binding_0_cs.sizes.z;
+    return ((((layer_1 * _e5) + row_4) * (_e11 / STRIDE)) + x_3);
 }
 
 vec4 encode_layer(vec4 v_10) {
@@ -398,7 +404,7 @@ void main() {
     uint row_6 = id.x;
     uint region = id.y;
     uint thread = id.z;
-    uint width_1 = _group_0_binding_0_cs.sizes.z;
+    uint width_2 = _group_0_binding_0_cs.sizes.z;
     uint _e14 = _group_0_binding_0_cs.sizes.w;
     if (!((row_6 >= _e14))) {
         local = (region >= REGIONS);
@@ -421,73 +427,79 @@ void main() {
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e37 = _group_0_binding_0_cs;
     float _e38 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e37, row_6);
     vec3 _e39 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e35, _e38);
-    uint _e42 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(region, REGIONS, width_1, false);
-    uint _e46 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((region + 1u), REGIONS, width_1, false);
-    i = _e42;
+    uint _e43 = region_columnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(region, REGIONS, width_2, STRIDE, false);
+    uint _e48 = region_columnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((region + 1u), REGIONS, width_2, STRIDE, false);
+    i = _e43;
     bool loop_init_2 = true;
     while(true) {
         if (!loop_init_2) {
-            uint _e118 = i;
-            i = (_e118 + 1u);
+            uint _e126 = i;
+            i = (_e126 + 1u);
         }
         loop_init_2 = false;
-        uint _e48 = i;
-        if ((_e48 < _e46)) {
+        uint _e50 = i;
+        if ((_e50 < _e48)) {
         } else {
             break;
         }
         {
-            uint _e50 = i;
-            int _e54_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_2_cs) - 1);
-            vec4 _e54 = texelFetch(_group_0_binding_2_cs, clamp(ivec2(uvec2(_e50, row_6)), ivec2(0), textureSize(_group_0_binding_2_cs, _e54_clamped_lod) - ivec2(1)), _e54_clamped_lod);
-            float d_2 = _e54.x;
-            FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e57 = _group_0_binding_0_cs;
-            uint _e58 = i;
-            float _e60 = texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e57, _e33, _e39, _e58, true, false);
-            float _e62 = wsum;
-            wsum = (_e62 + _e60);
+            uint _e52 = i;
+            int _e56_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_2_cs) - 1);
+            vec4 _e56 = texelFetch(_group_0_binding_2_cs, clamp(ivec2(uvec2(_e52, row_6)), ivec2(0), textureSize(_group_0_binding_2_cs, _e56_clamped_lod) - ivec2(1)), _e56_clamped_lod);
+            float d_2 = _e56.x;
+            FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e59 = _group_0_binding_0_cs;
+            uint _e60 = i;
+            float _e62 = texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e59, _e33, _e39, _e60, true, false);
+            float _e64 = wsum;
+            wsum = (_e64 + _e62);
+            uint _e66 = i;
+            bool store = ((_e66 % STRIDE) == 0u);
+            uint _e71 = i;
+            uint x_9 = (_e71 / STRIDE);
             if ((thread == 0u)) {
-                float _e67 = lo;
-                lo = min(_e67, d_2);
-                float _e70 = hi;
-                hi = max(_e70, d_2);
-                uint _e72 = i;
-                uint _e73 = bounds_index(_e72, row_6);
-                float _e76 = lo;
-                float _e77 = hi;
-                _group_0_binding_4_cs[_e73] = vec2(_e76, _e77);
+                float _e77 = lo;
+                lo = min(_e77, d_2);
+                float _e80 = hi;
+                hi = max(_e80, d_2);
+                if (store) {
+                    uint _e82 = bounds_index(x_9, row_6);
+                    float _e85 = lo;
+                    float _e86 = hi;
+                    _group_0_binding_4_cs[_e82] = vec2(_e85, _e86);
+                }
             }
-            float _e79 = wsum;
-            float _e81 = wsum;
-            float blend = ((_e81 > 0.0) ? (_e60 / _e79) : 0.0);
-            float _e86 = moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(d_2);
+            float _e88 = wsum;
+            float _e90 = wsum;
+            float blend = ((_e90 > 0.0) ? (_e62 / _e88) : 0.0);
+            float _e95 = moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(d_2);
             q = 0u;
             bool loop_init_3 = true;
             while(true) {
                 if (!loop_init_3) {
-                    uint _e115 = q;
-                    q = (_e115 + 1u);
+                    uint _e123 = q;
+                    q = (_e123 + 1u);
                 }
                 loop_init_3 = false;
-                uint _e90 = q;
-                if ((_e90 < 2u)) {
+                uint _e99 = q;
+                if ((_e99 < 2u)) {
                 } else {
                     break;
                 }
                 {
-                    uint _e93 = q;
-                    uint _e95 = q;
-                    vec4 _e97 = acc[_e95];
-                    uint _e101 = q;
-                    vec4 _e102 = moment_layerX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(_e86, _e101);
-                    acc[_e93] = ((_e97 * (1.0 - blend)) + (_e102 * blend));
-                    uint _e105 = i;
-                    uint _e106 = q;
-                    uint _e107 = filtered_index(_e105, row_6, _e106);
+                    uint _e102 = q;
+                    uint _e104 = q;
+                    vec4 _e106 = acc[_e104];
                     uint _e110 = q;
-                    vec4 _e112 = acc[_e110];
-                    vec4 _e113 = encode_layer(_e112);
-                    _group_0_binding_3_cs[_e107] = _e113;
+                    vec4 _e111 = moment_layerX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(_e95, _e110);
+                    acc[_e102] = ((_e106 * (1.0 - blend)) + (_e111 * blend));
+                    if (store) {
+                        uint _e114 = q;
+                        uint _e115 = filtered_index(x_9, row_6, _e114);
+                        uint _e118 = q;
+                        vec4 _e120 = acc[_e118];
+                        vec4 _e121 = encode_layer(_e120);
+                        _group_0_binding_3_cs[_e115] = _e121;
+                    }
                 }
             }
         }

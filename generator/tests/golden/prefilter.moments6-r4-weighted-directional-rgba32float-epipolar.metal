@@ -71,6 +71,7 @@ constant float PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = 3.1415927;
 constant metal::float4 GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = metal::float4(-0.8611363, -0.33998105, 0.33998105, 0.8611363);
 constant metal::float4 GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = metal::float4(0.34785485, 0.65214515, 0.65214515, 0.34785485);
 constant float CONE_FLOORX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX = 0.001;
+constant uint STRIDE = 1u;
 constant uint REGIONS = 4u;
 constant uint BASES_PER_THREAD = 6u;
 constant uint THREADS_PER_ROW_REGION = 1u;
@@ -427,15 +428,26 @@ uint region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
     return naga_div((r * r) * width, regions * regions);
 }
 
+uint region_columnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
+    uint r_1,
+    uint regions_1,
+    uint width_1,
+    uint stride,
+    bool spot_1
+) {
+    uint _e6 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(r_1, regions_1, naga_div(width_1, stride), spot_1);
+    return stride * _e6;
+}
+
 float ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_6,
     SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX s,
     float x_1,
-    bool spot_1
+    bool spot_2
 ) {
     bool local_2 = {};
     float cap = 4.0 * f_6.theta.z;
-    if (spot_1) {
+    if (spot_2) {
         float psi = x_1 * s.delta;
         float den = metal::sin(s.theta_ref + psi);
         if (!((den <= 0.0001))) {
@@ -459,25 +471,25 @@ float texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
     metal::float3 e_1,
     uint i_1,
     bool weighted,
-    bool spot_2
+    bool spot_3
 ) {
     float w = {};
-    float _e5 = ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_7, s_1, static_cast<float>(i_1), spot_2);
-    float _e9 = ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_7, s_1, static_cast<float>(i_1 + 1u), spot_2);
+    float _e5 = ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_7, s_1, static_cast<float>(i_1), spot_3);
+    float _e9 = ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_7, s_1, static_cast<float>(i_1 + 1u), spot_3);
     if (!(weighted)) {
         return _e9 - _e5;
     }
     float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_7.medium.x, _e5, _e9);
     w = _e15;
-    if (spot_2) {
+    if (spot_3) {
         float psi_1 = (static_cast<float>(i_1) + 0.5) * s_1.delta;
         metal::float3 l_1 = (-(f_7.axis.xyz) * metal::cos(psi_1)) + (e_1 * metal::sin(psi_1));
         float den_1 = metal::max(metal::sin(s_1.theta_ref + psi_1), 0.0001);
-        float r_1 = metal::max((f_7.axis.w * metal::sin(s_1.theta_ref)) / den_1, 0.0001);
+        float r_2 = metal::max((f_7.axis.w * metal::sin(s_1.theta_ref)) / den_1, 0.0001);
         float _e51 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(metal::dot(l_1, f_7.light_dir.xyz), f_7.light_pos.w, f_7.light_dir.w);
         float cone = metal::max(_e51, CONE_FLOORX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX);
         float _e54 = w;
-        w = _e54 * ((cone * metal::exp(-(f_7.medium.x) * r_1)) / (r_1 * r_1));
+        w = _e54 * ((cone * metal::exp(-(f_7.medium.x) * r_2)) / (r_2 * r_2));
     }
     float _e64 = w;
     return _e64;
@@ -517,8 +529,8 @@ uint filtered_index(
     constant FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX& frame
 ) {
     uint _e5 = frame.sizes.w;
-    uint _e12 = frame.sizes.z;
-    return (((layer_1 * _e5) + row_4) * _e12) + x_3;
+    uint _e11 = frame.sizes.z;
+    return (((layer_1 * _e5) + row_4) * naga_div(_e11, STRIDE)) + x_3;
 }
 
 metal::float4 encode_layer(
@@ -546,6 +558,10 @@ metal::float4 filtered_load(
     metal::float4 _e7 = decode_layer(_e6);
     return _e7;
 }
+uint naga_mod(uint lhs, uint rhs) {
+    return lhs % metal::select(rhs, 1u, rhs == 0u);
+}
+
 
 struct prefilterInput {
 };
@@ -569,7 +585,7 @@ kernel void prefilter(
     uint row_6 = id.x;
     uint region = id.y;
     uint thread_ = id.z;
-    uint width_1 = frame.sizes.z;
+    uint width_2 = frame.sizes.z;
     uint _e14 = frame.sizes.w;
     if (!((row_6 >= _e14))) {
         local = region >= REGIONS;
@@ -592,49 +608,54 @@ kernel void prefilter(
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e37 = frame;
     float _e38 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e37, row_6);
     metal::float3 _e39 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e35, _e38);
-    uint _e42 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(region, REGIONS, width_1, false);
-    uint _e46 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(region + 1u, REGIONS, width_1, false);
-    i = _e42;
+    uint _e43 = region_columnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(region, REGIONS, width_2, STRIDE, false);
+    uint _e48 = region_columnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(region + 1u, REGIONS, width_2, STRIDE, false);
+    i = _e43;
     uint2 loop_bound_2 = uint2(4294967295u);
     bool loop_init_2 = true;
     while(true) {
         if (metal::all(loop_bound_2 == uint2(0u))) { break; }
         loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
         if (!loop_init_2) {
-            uint _e118 = i;
-            i = _e118 + 1u;
+            uint _e126 = i;
+            i = _e126 + 1u;
         }
         loop_init_2 = false;
-        uint _e48 = i;
-        if (_e48 < _e46) {
+        uint _e50 = i;
+        if (_e50 < _e48) {
         } else {
             break;
         }
         {
-            uint _e50 = i;
-            uint clamped_lod_e54 = metal::min(uint(0), rectified.get_num_mip_levels() - 1);
-            metal::float4 _e54 = rectified.read(metal::min(metal::uint2(metal::uint2(_e50, row_6)), metal::uint2(rectified.get_width(clamped_lod_e54), rectified.get_height(clamped_lod_e54)) - 1), clamped_lod_e54);
-            float d_2 = _e54.x;
-            FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e57 = frame;
-            uint _e58 = i;
-            float _e60 = texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e57, _e33, _e39, _e58, true, false);
-            float _e62 = wsum;
-            wsum = _e62 + _e60;
+            uint _e52 = i;
+            uint clamped_lod_e56 = metal::min(uint(0), rectified.get_num_mip_levels() - 1);
+            metal::float4 _e56 = rectified.read(metal::min(metal::uint2(metal::uint2(_e52, row_6)), metal::uint2(rectified.get_width(clamped_lod_e56), rectified.get_height(clamped_lod_e56)) - 1), clamped_lod_e56);
+            float d_2 = _e56.x;
+            FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e59 = frame;
+            uint _e60 = i;
+            float _e62 = texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e59, _e33, _e39, _e60, true, false);
+            float _e64 = wsum;
+            wsum = _e64 + _e62;
+            uint _e66 = i;
+            bool store = naga_mod(_e66, STRIDE) == 0u;
+            uint _e71 = i;
+            uint x_9 = naga_div(_e71, STRIDE);
             if (thread_ == 0u) {
-                float _e67 = lo;
-                lo = metal::min(_e67, d_2);
-                float _e70 = hi;
-                hi = metal::max(_e70, d_2);
-                uint _e72 = i;
-                uint _e73 = bounds_index(_e72, row_6, frame);
-                float _e76 = lo;
-                float _e77 = hi;
-                bounds[metal::min(unsigned(_e73), (_buffer_sizes.size4 - 0 - 8) / 8)] = metal::float2(_e76, _e77);
+                float _e77 = lo;
+                lo = metal::min(_e77, d_2);
+                float _e80 = hi;
+                hi = metal::max(_e80, d_2);
+                if (store) {
+                    uint _e82 = bounds_index(x_9, row_6, frame);
+                    float _e85 = lo;
+                    float _e86 = hi;
+                    bounds[metal::min(unsigned(_e82), (_buffer_sizes.size4 - 0 - 8) / 8)] = metal::float2(_e85, _e86);
+                }
             }
-            float _e79 = wsum;
-            float _e81 = wsum;
-            float blend = (_e81 > 0.0) ? (_e60 / _e79) : 0.0;
-            float _e86 = moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(d_2);
+            float _e88 = wsum;
+            float _e90 = wsum;
+            float blend = (_e90 > 0.0) ? (_e62 / _e88) : 0.0;
+            float _e95 = moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(d_2);
             q = 0u;
             uint2 loop_bound_3 = uint2(4294967295u);
             bool loop_init_3 = true;
@@ -642,29 +663,30 @@ kernel void prefilter(
                 if (metal::all(loop_bound_3 == uint2(0u))) { break; }
                 loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
                 if (!loop_init_3) {
-                    uint _e115 = q;
-                    q = _e115 + 1u;
+                    uint _e123 = q;
+                    q = _e123 + 1u;
                 }
                 loop_init_3 = false;
-                uint _e90 = q;
-                if (_e90 < 2u) {
+                uint _e99 = q;
+                if (_e99 < 2u) {
                 } else {
                     break;
                 }
                 {
-                    uint _e93 = q;
-                    uint _e95 = q;
-                    metal::float4 _e97 = acc.inner[metal::min(unsigned(_e95), 1u)];
-                    uint _e101 = q;
-                    metal::float4 _e102 = moment_layerX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(_e86, _e101);
-                    acc.inner[metal::min(unsigned(_e93), 1u)] = (_e97 * (1.0 - blend)) + (_e102 * blend);
-                    uint _e105 = i;
-                    uint _e106 = q;
-                    uint _e107 = filtered_index(_e105, row_6, _e106, frame);
+                    uint _e102 = q;
+                    uint _e104 = q;
+                    metal::float4 _e106 = acc.inner[metal::min(unsigned(_e104), 1u)];
                     uint _e110 = q;
-                    metal::float4 _e112 = acc.inner[metal::min(unsigned(_e110), 1u)];
-                    metal::float4 _e113 = encode_layer(_e112);
-                    filtered[metal::min(unsigned(_e107), (_buffer_sizes.size3 - 0 - 16) / 16)] = _e113;
+                    metal::float4 _e111 = moment_layerX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(_e95, _e110);
+                    acc.inner[metal::min(unsigned(_e102), 1u)] = (_e106 * (1.0 - blend)) + (_e111 * blend);
+                    if (store) {
+                        uint _e114 = q;
+                        uint _e115 = filtered_index(x_9, row_6, _e114, frame);
+                        uint _e118 = q;
+                        metal::float4 _e120 = acc.inner[metal::min(unsigned(_e118), 1u)];
+                        metal::float4 _e121 = encode_layer(_e120);
+                        filtered[metal::min(unsigned(_e115), (_buffer_sizes.size3 - 0 - 16) / 16)] = _e121;
+                    }
                 }
             }
         }

@@ -58,6 +58,7 @@ const PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX: f32 = 3.1415927f;
 const GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX: vec4<f32> = vec4<f32>(-0.8611363f, -0.33998105f, 0.33998105f, 0.8611363f);
 const GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX: vec4<f32> = vec4<f32>(0.34785485f, 0.65214515f, 0.65214515f, 0.34785485f);
 const CONE_FLOORX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX: f32 = 0.001f;
+const STRIDE: u32 = 1u;
 const REGIONS: u32 = 4u;
 const BASES_PER_THREAD: u32 = 6u;
 const THREADS_PER_ROW_REGION: u32 = 1u;
@@ -304,11 +305,16 @@ fn region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(r: u32, regions
     return (((r * r) * width) / (regions * regions));
 }
 
-fn ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_6: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, s: SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_1: f32, spot_1: bool) -> f32 {
+fn region_columnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(r_1: u32, regions_1: u32, width_1: u32, stride: u32, spot_1: bool) -> u32 {
+    let _e6 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(r_1, regions_1, (width_1 / stride), spot_1);
+    return (stride * _e6);
+}
+
+fn ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_6: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, s: SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, x_1: f32, spot_2: bool) -> f32 {
     var local_2: bool;
 
     let cap = (4f * f_6.theta.z);
-    if spot_1 {
+    if spot_2 {
         let psi = (x_1 * s.delta);
         let den = sin((s.theta_ref + psi));
         if !((den <= 0.0001f)) {
@@ -326,25 +332,25 @@ fn ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_6: FrameX_naga_oil_m
     }
 }
 
-fn texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_7: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, s_1: SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, e_1: vec3<f32>, i_1: u32, weighted: bool, spot_2: bool) -> f32 {
+fn texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_7: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, s_1: SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, e_1: vec3<f32>, i_1: u32, weighted: bool, spot_3: bool) -> f32 {
     var w: f32;
 
-    let _e5 = ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_7, s_1, f32(i_1), spot_2);
-    let _e9 = ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_7, s_1, f32((i_1 + 1u)), spot_2);
+    let _e5 = ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_7, s_1, f32(i_1), spot_3);
+    let _e9 = ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_7, s_1, f32((i_1 + 1u)), spot_3);
     if !(weighted) {
         return (_e9 - _e5);
     }
     let _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_7.medium.x, _e5, _e9);
     w = _e15;
-    if spot_2 {
+    if spot_3 {
         let psi_1 = ((f32(i_1) + 0.5f) * s_1.delta);
         let l_1 = ((-(f_7.axis.xyz) * cos(psi_1)) + (e_1 * sin(psi_1)));
         let den_1 = max(sin((s_1.theta_ref + psi_1)), 0.0001f);
-        let r_1 = max(((f_7.axis.w * sin(s_1.theta_ref)) / den_1), 0.0001f);
+        let r_2 = max(((f_7.axis.w * sin(s_1.theta_ref)) / den_1), 0.0001f);
         let _e51 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(l_1, f_7.light_dir.xyz), f_7.light_pos.w, f_7.light_dir.w);
         let cone = max(_e51, CONE_FLOORX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX);
         let _e54 = w;
-        w = (_e54 * ((cone * exp((-(f_7.medium.x) * r_1))) / (r_1 * r_1)));
+        w = (_e54 * ((cone * exp((-(f_7.medium.x) * r_2))) / (r_2 * r_2)));
     }
     let _e64 = w;
     return _e64;
@@ -370,8 +376,8 @@ fn bounds_index(x_2: u32, row_3: u32) -> u32 {
 
 fn filtered_index(x_3: u32, row_4: u32, layer_1: u32) -> u32 {
     let _e5 = frame.sizes.w;
-    let _e12 = frame.sizes.z;
-    return ((((layer_1 * _e5) + row_4) * _e12) + x_3);
+    let _e11 = frame.sizes.z;
+    return ((((layer_1 * _e5) + row_4) * (_e11 / STRIDE)) + x_3);
 }
 
 fn encode_layer(v_10: vec4<f32>) -> vec4<f32> {
@@ -403,7 +409,7 @@ fn prefilter(@builtin(global_invocation_id) id: vec3<u32>) {
     let row_6 = id.x;
     let region = id.y;
     let thread = id.z;
-    let width_1 = frame.sizes.z;
+    let width_2 = frame.sizes.z;
     let _e14 = frame.sizes.w;
     if !((row_6 >= _e14)) {
         local = (region >= REGIONS);
@@ -426,70 +432,76 @@ fn prefilter(@builtin(global_invocation_id) id: vec3<u32>) {
     let _e37 = frame;
     let _e38 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e37, row_6);
     let _e39 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e35, _e38);
-    let _e42 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(region, REGIONS, width_1, false);
-    let _e46 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((region + 1u), REGIONS, width_1, false);
-    i = _e42;
+    let _e43 = region_columnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(region, REGIONS, width_2, STRIDE, false);
+    let _e48 = region_columnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((region + 1u), REGIONS, width_2, STRIDE, false);
+    i = _e43;
     loop {
-        let _e48 = i;
-        if (_e48 < _e46) {
+        let _e50 = i;
+        if (_e50 < _e48) {
         } else {
             break;
         }
         {
-            let _e50 = i;
-            let _e54 = textureLoad(rectified, vec2<u32>(_e50, row_6), 0i);
-            let d_2 = _e54.x;
-            let _e57 = frame;
-            let _e58 = i;
-            let _e60 = texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e57, _e33, _e39, _e58, true, false);
-            let _e62 = wsum;
-            wsum = (_e62 + _e60);
+            let _e52 = i;
+            let _e56 = textureLoad(rectified, vec2<u32>(_e52, row_6), 0i);
+            let d_2 = _e56.x;
+            let _e59 = frame;
+            let _e60 = i;
+            let _e62 = texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e59, _e33, _e39, _e60, true, false);
+            let _e64 = wsum;
+            wsum = (_e64 + _e62);
+            let _e66 = i;
+            let store = ((_e66 % STRIDE) == 0u);
+            let _e71 = i;
+            let x_9 = (_e71 / STRIDE);
             if (thread == 0u) {
-                let _e67 = lo;
-                lo = min(_e67, d_2);
-                let _e70 = hi;
-                hi = max(_e70, d_2);
-                let _e72 = i;
-                let _e73 = bounds_index(_e72, row_6);
-                let _e76 = lo;
-                let _e77 = hi;
-                bounds[_e73] = vec2<f32>(_e76, _e77);
+                let _e77 = lo;
+                lo = min(_e77, d_2);
+                let _e80 = hi;
+                hi = max(_e80, d_2);
+                if store {
+                    let _e82 = bounds_index(x_9, row_6);
+                    let _e85 = lo;
+                    let _e86 = hi;
+                    bounds[_e82] = vec2<f32>(_e85, _e86);
+                }
             }
-            let _e79 = wsum;
-            let _e81 = wsum;
-            let blend = select(0f, (_e60 / _e79), (_e81 > 0f));
-            let _e86 = moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(d_2);
+            let _e88 = wsum;
+            let _e90 = wsum;
+            let blend = select(0f, (_e62 / _e88), (_e90 > 0f));
+            let _e95 = moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(d_2);
             q = 0u;
             loop {
-                let _e90 = q;
-                if (_e90 < 2u) {
+                let _e99 = q;
+                if (_e99 < 2u) {
                 } else {
                     break;
                 }
                 {
-                    let _e93 = q;
-                    let _e95 = q;
-                    let _e97 = acc[_e95];
-                    let _e101 = q;
-                    let _e102 = moment_layerX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(_e86, _e101);
-                    acc[_e93] = ((_e97 * (1f - blend)) + (_e102 * blend));
-                    let _e105 = i;
-                    let _e106 = q;
-                    let _e107 = filtered_index(_e105, row_6, _e106);
+                    let _e102 = q;
+                    let _e104 = q;
+                    let _e106 = acc[_e104];
                     let _e110 = q;
-                    let _e112 = acc[_e110];
-                    let _e113 = encode_layer(_e112);
-                    filtered[_e107] = _e113;
+                    let _e111 = moment_layerX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(_e95, _e110);
+                    acc[_e102] = ((_e106 * (1f - blend)) + (_e111 * blend));
+                    if store {
+                        let _e114 = q;
+                        let _e115 = filtered_index(x_9, row_6, _e114);
+                        let _e118 = q;
+                        let _e120 = acc[_e118];
+                        let _e121 = encode_layer(_e120);
+                        filtered[_e115] = _e121;
+                    }
                 }
                 continuing {
-                    let _e115 = q;
-                    q = (_e115 + 1u);
+                    let _e123 = q;
+                    q = (_e123 + 1u);
                 }
             }
         }
         continuing {
-            let _e118 = i;
-            i = (_e118 + 1u);
+            let _e126 = i;
+            i = (_e126 + 1u);
         }
     }
     return;

@@ -72,6 +72,7 @@ constant float PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = 3.1415927;
 constant metal::float4 GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = metal::float4(-0.8611363, -0.33998105, 0.33998105, 0.8611363);
 constant metal::float4 GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = metal::float4(0.34785485, 0.65214515, 0.65214515, 0.34785485);
 constant float DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX = 0.1;
+constant uint STRIDE = 1u;
 constant uint REGIONS = 1u;
 constant uint LAYERS = 4u;
 
@@ -637,9 +638,9 @@ uint filtered_index(
     uint layer_1,
     constant FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX& frame
 ) {
-    uint _e5 = frame.sizes.z;
-    uint _e12 = frame.sizes.w;
-    return (((layer_1 * _e5) + x_4) * _e12) + row_1;
+    uint _e3 = frame.sizes.z;
+    uint _e14 = frame.sizes.w;
+    return (((layer_1 * naga_div(_e3, STRIDE)) + x_4) * _e14) + row_1;
 }
 
 metal::uint2 encode_layer(
@@ -730,164 +731,164 @@ metal::float3 scatter_pixel(
     }
     metal::float3 axis = f_12.axis.xyz;
     uint rows_2 = f_12.sizes.w;
-    uint width_1 = f_12.sizes.z;
+    uint width_1 = naga_div(f_12.sizes.z, STRIDE);
     bool wrap_1 = f_12.anti_epipole.w > 0.5;
     {
         theta_3 = metal::acos(metal::clamp(metal::dot(_e10, axis), -1.0, 1.0));
-        float _e59 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, _e10);
-        yc = _e59;
-        float _e61 = theta_3;
-        float _e66 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e61, f_12.theta.x, f_12.theta.y);
-        d = _e66;
-        float _e68 = theta_3;
-        float _e69 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, _e10, s_3, _e68, true);
-        reach = _e69;
+        float _e61 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, _e10);
+        yc = _e61;
+        float _e63 = theta_3;
+        float _e68 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e63, f_12.theta.x, f_12.theta.y);
+        d = _e68;
+        float _e70 = theta_3;
+        float _e71 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, _e10, s_3, _e70, true);
+        reach = _e71;
     }
-    float _e71 = yc;
-    float yb = _e71 - 0.5;
+    float _e73 = yc;
+    float yb = _e73 - 0.5;
     float fy = yb - metal::floor(yb);
-    uint _e77 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(metal::floor(yb), rows_2, wrap_1);
-    uint _e81 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(metal::floor(yb) + 1.0, rows_2, wrap_1);
-    uint row1_ = (yb > metal::floor(yb)) ? _e81 : _e77;
-    float w1_ = (row1_ != _e77) ? fy : 0.0;
+    uint _e79 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(metal::floor(yb), rows_2, wrap_1);
+    uint _e83 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(metal::floor(yb) + 1.0, rows_2, wrap_1);
+    uint row1_ = (yb > metal::floor(yb)) ? _e83 : _e79;
+    float w1_ = (row1_ != _e79) ? fy : 0.0;
     float cos_theta_l = -(metal::dot(f_12.light_dir.xyz, _e10));
     uint panels_2 = metal::max(naga_div(f_12.sizes2_.z, 4u), 1u);
-    float _e99 = d;
-    float _e103 = d;
-    angle = metal::float2(metal::sin(PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e99), metal::cos(PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e103));
-    metal::float2 _e108 = angle;
-    metal::float2 _e109 = fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e108);
+    float _e101 = d;
+    float _e105 = d;
+    angle = metal::float2(metal::sin(PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e101), metal::cos(PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e105));
+    metal::float2 _e110 = angle;
+    metal::float2 _e111 = fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e110);
     uint2 loop_bound_3 = uint2(4294967295u);
     bool loop_init_3 = true;
     while(true) {
         if (metal::all(loop_bound_3 == uint2(0u))) { break; }
         loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
         if (!loop_init_3) {
-            uint _e124 = layer_3;
-            layer_3 = _e124 + 1u;
+            uint _e126 = layer_3;
+            layer_3 = _e126 + 1u;
         }
         loop_init_3 = false;
-        uint _e111 = layer_3;
-        if (_e111 < LAYERS) {
+        uint _e113 = layer_3;
+        if (_e113 < LAYERS) {
         } else {
             break;
         }
         {
-            metal::float2 _e114 = angle;
-            metal::float2 _e115 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e114, _e109);
-            uint _e117 = layer_3;
-            metal::float2 _e119 = angle;
-            uint _e120 = layer_3;
-            metal::float4 _e121 = coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e119, _e115, _e120);
-            coeffs.inner[metal::min(unsigned(_e117), 3u)] = _e121;
-            metal::float2 _e122 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e115, _e109);
-            angle = _e122;
+            metal::float2 _e116 = angle;
+            metal::float2 _e117 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e116, _e111);
+            uint _e119 = layer_3;
+            metal::float2 _e121 = angle;
+            uint _e122 = layer_3;
+            metal::float4 _e123 = coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e121, _e117, _e122);
+            coeffs.inner[metal::min(unsigned(_e119), 3u)] = _e123;
+            metal::float2 _e124 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e117, _e111);
+            angle = _e124;
         }
     }
-    float _e130 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.z, cos_theta_l);
-    float sun_scatter = f_12.medium.y * _e130;
-    float _e133 = xs;
-    xs0_ = _e133;
+    float _e132 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.z, cos_theta_l);
+    float sun_scatter = f_12.medium.y * _e132;
     float _e135 = xs;
-    xs1_ = _e135;
+    xs0_ = _e135;
+    float _e137 = xs;
+    xs1_ = _e137;
     {
-        metal::float4 _e139 = slices[metal::min(unsigned(_e77), (_buffer_sizes.size1 - 0 - 16) / 16)];
-        SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e140 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e139);
-        delta0_ = _e140.delta;
-        metal::float4 _e145 = slices[metal::min(unsigned(row1_), (_buffer_sizes.size1 - 0 - 16) / 16)];
-        SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e146 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e145);
-        delta1_ = _e146.delta;
-        float _e149 = reach;
-        float _e150 = delta0_;
-        xs0_ = _e149 / _e150;
-        float _e152 = reach;
-        float _e153 = delta1_;
-        xs1_ = _e152 / _e153;
+        metal::float4 _e141 = slices[metal::min(unsigned(_e79), (_buffer_sizes.size1 - 0 - 16) / 16)];
+        SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e142 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e141);
+        delta0_ = 1.0 * _e142.delta;
+        metal::float4 _e149 = slices[metal::min(unsigned(row1_), (_buffer_sizes.size1 - 0 - 16) / 16)];
+        SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e150 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e149);
+        delta1_ = 1.0 * _e150.delta;
+        float _e155 = reach;
+        float _e156 = delta0_;
+        xs0_ = _e155 / _e156;
+        float _e158 = reach;
+        float _e159 = delta1_;
+        xs1_ = _e158 / _e159;
     }
-    float _e155 = xs0_;
-    uint last0_ = naga_f2u32(metal::min(metal::max(_e155, 0.0), static_cast<float>(width_1) - 1.0));
-    float _e163 = xs1_;
-    uint last1_ = naga_f2u32(metal::min(metal::max(_e163, 0.0), static_cast<float>(width_1) - 1.0));
+    float _e161 = xs0_;
+    uint last0_ = naga_f2u32(metal::min(metal::max(_e161, 0.0), static_cast<float>(width_1) - 1.0));
+    float _e169 = xs1_;
+    uint last1_ = naga_f2u32(metal::min(metal::max(_e169, 0.0), static_cast<float>(width_1) - 1.0));
     uint2 loop_bound_4 = uint2(4294967295u);
     bool loop_init_4 = true;
     while(true) {
         if (metal::all(loop_bound_4 == uint2(0u))) { break; }
         loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
         if (!loop_init_4) {
-            uint _e462 = r_1;
-            r_1 = _e462 + 1u;
+            uint _e468 = r_1;
+            r_1 = _e468 + 1u;
         }
         loop_init_4 = false;
-        uint _e173 = r_1;
-        if (_e173 < REGIONS) {
+        uint _e179 = r_1;
+        if (_e179 < REGIONS) {
         } else {
             break;
         }
         {
-            uint _e175 = r_1;
-            uint _e176 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e175, REGIONS, width_1, true);
-            float b0_ = static_cast<float>(_e176);
-            uint _e178 = r_1;
-            uint _e181 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e178 + 1u, REGIONS, width_1, true);
-            float b1_ = static_cast<float>(_e181);
+            uint _e181 = r_1;
+            uint _e182 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e181, REGIONS, width_1, true);
+            float b0_ = static_cast<float>(_e182);
+            uint _e184 = r_1;
+            uint _e187 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e184 + 1u, REGIONS, width_1, true);
+            float b1_ = static_cast<float>(_e187);
             if (!((last0_ < naga_f2u32(b1_)))) {
-                uint _e186 = r_1;
-                local_2 = (_e186 + 1u) == REGIONS;
+                uint _e192 = r_1;
+                local_2 = (_e192 + 1u) == REGIONS;
             } else {
                 local_2 = true;
             }
             bool is_last0_ = local_2;
             if (!((last1_ < naga_f2u32(b1_)))) {
-                uint _e197 = r_1;
-                local_3 = (_e197 + 1u) == REGIONS;
+                uint _e203 = r_1;
+                local_3 = (_e203 + 1u) == REGIONS;
             } else {
                 local_3 = true;
             }
             bool is_last1_ = local_3;
-            float _e207 = xs0_;
-            float pos0_ = is_last0_ ? metal::clamp(_e207 - 0.5, b0_ + 0.5, b1_ - 0.5) : (b1_ - 0.5);
-            float _e218 = xs1_;
-            float pos1_ = is_last1_ ? metal::clamp(_e218 - 0.5, b0_ + 0.5, b1_ - 0.5) : (b1_ - 0.5);
+            float _e213 = xs0_;
+            float pos0_ = is_last0_ ? metal::clamp(_e213 - 0.5, b0_ + 0.5, b1_ - 0.5) : (b1_ - 0.5);
+            float _e224 = xs1_;
+            float pos1_ = is_last1_ ? metal::clamp(_e224 - 0.5, b0_ + 0.5, b1_ - 0.5) : (b1_ - 0.5);
             a0_ = float {};
             e0_ = float {};
             a1_ = float {};
             e1_ = float {};
-            float _e235 = delta0_;
-            float _e236 = theta_3;
-            float _e237 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b0_, _e235, _e236, s_3, true);
-            a0_ = _e237;
-            float _e238 = delta0_;
-            float _e239 = theta_3;
-            float _e240 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b1_, _e238, _e239, s_3, true);
-            e0_ = is_last0_ ? s_3 : _e240;
-            float _e242 = delta1_;
-            float _e243 = theta_3;
-            float _e244 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b0_, _e242, _e243, s_3, true);
-            a1_ = _e244;
-            float _e245 = delta1_;
-            float _e246 = theta_3;
-            float _e247 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b1_, _e245, _e246, s_3, true);
-            e1_ = is_last1_ ? s_3 : _e247;
+            float _e241 = delta0_;
+            float _e242 = theta_3;
+            float _e243 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b0_, _e241, _e242, s_3, true);
+            a0_ = _e243;
+            float _e244 = delta0_;
+            float _e245 = theta_3;
+            float _e246 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b1_, _e244, _e245, s_3, true);
+            e0_ = is_last0_ ? s_3 : _e246;
+            float _e248 = delta1_;
+            float _e249 = theta_3;
+            float _e250 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b0_, _e248, _e249, s_3, true);
+            a1_ = _e250;
+            float _e251 = delta1_;
+            float _e252 = theta_3;
+            float _e253 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b1_, _e251, _e252, s_3, true);
+            e1_ = is_last1_ ? s_3 : _e253;
             weight0_ = float {};
             weight1_ = float {};
             if (true) {
-                float _e253 = a0_;
-                float _e254 = e0_;
-                float _e255 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, _e10, _e253, _e254, panels_2);
-                weight0_ = _e255;
-                float _e256 = a1_;
-                float _e257 = e1_;
-                float _e258 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, _e10, _e256, _e257, panels_2);
-                weight1_ = _e258;
+                float _e259 = a0_;
+                float _e260 = e0_;
+                float _e261 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, _e10, _e259, _e260, panels_2);
+                weight0_ = _e261;
+                float _e262 = a1_;
+                float _e263 = e1_;
+                float _e264 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, _e10, _e262, _e263, panels_2);
+                weight1_ = _e264;
             } else {
-                float _e261 = a0_;
-                float _e262 = e0_;
-                float _e263 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.x, _e261, _e262);
-                weight0_ = sun_scatter * _e263;
-                float _e267 = a1_;
-                float _e268 = e1_;
+                float _e267 = a0_;
+                float _e268 = e0_;
                 float _e269 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.x, _e267, _e268);
-                weight1_ = sun_scatter * _e269;
+                weight0_ = sun_scatter * _e269;
+                float _e273 = a1_;
+                float _e274 = e1_;
+                float _e275 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.x, _e273, _e274);
+                weight1_ = sun_scatter * _e275;
             }
             float xb0_ = pos0_ - 0.5;
             float fx0_ = xb0_ - metal::floor(xb0_);
@@ -897,35 +898,35 @@ metal::float3 scatter_pixel(
             float fx1_ = xb1_ - metal::floor(xb1_);
             uint x10_ = naga_f2u32(metal::clamp(metal::floor(xb1_), 0.0, static_cast<float>(width_1) - 1.0));
             uint x11_ = (xb1_ > metal::floor(xb1_)) ? metal::min(x10_ + 1u, width_1 - 1u) : x10_;
-            uint _e309 = bounds_index(x01_, _e77, frame);
-            metal::float2 lohi0_ = bounds[metal::min(unsigned(_e309), (_buffer_sizes.size6 - 0 - 8) / 8)];
-            uint _e313 = bounds_index(x11_, row1_, frame);
-            metal::float2 lohi1_ = bounds[metal::min(unsigned(_e313), (_buffer_sizes.size6 - 0 - 8) / 8)];
+            uint _e315 = bounds_index(x01_, _e79, frame);
+            metal::float2 lohi0_ = bounds[metal::min(unsigned(_e315), (_buffer_sizes.size6 - 0 - 8) / 8)];
+            uint _e319 = bounds_index(x11_, row1_, frame);
+            metal::float2 lohi1_ = bounds[metal::min(unsigned(_e319), (_buffer_sizes.size6 - 0 - 8) / 8)];
             vis0_ = 0.5;
             vis1_ = 0.5;
-            float _e321 = d;
-            if (_e321 > lohi0_.x) {
-                float _e324 = d;
-                local_4 = _e324 <= lohi0_.y;
+            float _e327 = d;
+            if (_e327 > lohi0_.x) {
+                float _e330 = d;
+                local_4 = _e330 <= lohi0_.y;
             } else {
                 local_4 = false;
             }
-            bool _e330 = local_4;
-            if (!(_e330)) {
-                float _e332 = d;
-                if (_e332 > lohi1_.x) {
-                    float _e335 = d;
-                    local_6 = _e335 <= lohi1_.y;
+            bool _e336 = local_4;
+            if (!(_e336)) {
+                float _e338 = d;
+                if (_e338 > lohi1_.x) {
+                    float _e341 = d;
+                    local_6 = _e341 <= lohi1_.y;
                 } else {
                     local_6 = false;
                 }
-                bool _e341 = local_6;
-                local_5 = _e341;
+                bool _e347 = local_6;
+                local_5 = _e347;
             } else {
                 local_5 = true;
             }
-            bool _e345 = local_5;
-            if (_e345) {
+            bool _e351 = local_5;
+            if (_e351) {
                 layer_4 = 0u;
                 uint2 loop_bound_5 = uint2(4294967295u);
                 bool loop_init_5 = true;
@@ -933,28 +934,28 @@ metal::float3 scatter_pixel(
                     if (metal::all(loop_bound_5 == uint2(0u))) { break; }
                     loop_bound_5 -= uint2(loop_bound_5.y == 0u, 1u);
                     if (!loop_init_5) {
-                        uint _e395 = layer_4;
-                        layer_4 = _e395 + 1u;
+                        uint _e401 = layer_4;
+                        layer_4 = _e401 + 1u;
                     }
                     loop_init_5 = false;
-                    uint _e348 = layer_4;
-                    if (_e348 < LAYERS) {
+                    uint _e354 = layer_4;
+                    if (_e354 < LAYERS) {
                     } else {
                         break;
                     }
                     {
-                        uint _e351 = layer_4;
-                        metal::float4 coeff = coeffs.inner[metal::min(unsigned(_e351), 3u)];
-                        uint _e354 = layer_4;
-                        metal::float4 _e355 = filtered_load(x00_, _e77, _e354, frame, filtered, _buffer_sizes);
-                        uint _e356 = layer_4;
-                        metal::float4 _e357 = filtered_load(x01_, _e77, _e356, frame, filtered, _buffer_sizes);
-                        metal::float4 texel0_ = metal::mix(_e355, _e357, fx0_);
-                        uint _e359 = layer_4;
-                        metal::float4 _e360 = filtered_load(x10_, row1_, _e359, frame, filtered, _buffer_sizes);
-                        uint _e361 = layer_4;
-                        metal::float4 _e362 = filtered_load(x11_, row1_, _e361, frame, filtered, _buffer_sizes);
-                        metal::float4 texel1_ = metal::mix(_e360, _e362, fx1_);
+                        uint _e357 = layer_4;
+                        metal::float4 coeff = coeffs.inner[metal::min(unsigned(_e357), 3u)];
+                        uint _e360 = layer_4;
+                        metal::float4 _e361 = filtered_load(x00_, _e79, _e360, frame, filtered, _buffer_sizes);
+                        uint _e362 = layer_4;
+                        metal::float4 _e363 = filtered_load(x01_, _e79, _e362, frame, filtered, _buffer_sizes);
+                        metal::float4 texel0_ = metal::mix(_e361, _e363, fx0_);
+                        uint _e365 = layer_4;
+                        metal::float4 _e366 = filtered_load(x10_, row1_, _e365, frame, filtered, _buffer_sizes);
+                        uint _e367 = layer_4;
+                        metal::float4 _e368 = filtered_load(x11_, row1_, _e367, frame, filtered, _buffer_sizes);
+                        metal::float4 texel1_ = metal::mix(_e366, _e368, fx1_);
                         k_3 = 0u;
                         uint2 loop_bound_6 = uint2(4294967295u);
                         bool loop_init_6 = true;
@@ -962,83 +963,83 @@ metal::float3 scatter_pixel(
                             if (metal::all(loop_bound_6 == uint2(0u))) { break; }
                             loop_bound_6 -= uint2(loop_bound_6.y == 0u, 1u);
                             if (!loop_init_6) {
-                                uint _e392 = k_3;
-                                k_3 = _e392 + 1u;
+                                uint _e398 = k_3;
+                                k_3 = _e398 + 1u;
                             }
                             loop_init_6 = false;
-                            uint _e366 = k_3;
-                            if (_e366 < 4u) {
+                            uint _e372 = k_3;
+                            if (_e372 < 4u) {
                             } else {
                                 break;
                             }
                             {
-                                float _e369 = vis0_;
-                                uint _e370 = k_3;
-                                uint _e372 = k_3;
-                                vis0_ = _e369 + (coeff[metal::min(unsigned(_e370), 3u)] * ((texel0_[metal::min(unsigned(_e372), 3u)] * 2.0) - 1.0));
-                                float _e380 = vis1_;
-                                uint _e381 = k_3;
-                                uint _e383 = k_3;
-                                vis1_ = _e380 + (coeff[metal::min(unsigned(_e381), 3u)] * ((texel1_[metal::min(unsigned(_e383), 3u)] * 2.0) - 1.0));
+                                float _e375 = vis0_;
+                                uint _e376 = k_3;
+                                uint _e378 = k_3;
+                                vis0_ = _e375 + (coeff[metal::min(unsigned(_e376), 3u)] * ((texel0_[metal::min(unsigned(_e378), 3u)] * 2.0) - 1.0));
+                                float _e386 = vis1_;
+                                uint _e387 = k_3;
+                                uint _e389 = k_3;
+                                vis1_ = _e386 + (coeff[metal::min(unsigned(_e387), 3u)] * ((texel1_[metal::min(unsigned(_e389), 3u)] * 2.0) - 1.0));
                             }
                         }
                     }
                 }
             }
-            float _e397 = vis0_;
-            float _e398 = d;
-            float _e403 = d;
-            vis0_ = (_e403 <= lohi0_.x) ? 1.0 : ((_e398 > lohi0_.y) ? 0.0 : _e397);
-            float _e408 = vis1_;
+            float _e403 = vis0_;
+            float _e404 = d;
             float _e409 = d;
-            float _e414 = d;
-            vis1_ = (_e414 <= lohi1_.x) ? 1.0 : ((_e409 > lohi1_.y) ? 0.0 : _e408);
-            bool _e420 = done0_;
-            if (!(_e420)) {
-                float _e423 = total0_;
-                float _e424 = weight0_;
-                float _e425 = vis0_;
-                total0_ = _e423 + (_e424 * metal::clamp(_e425, 0.0, 1.0));
+            vis0_ = (_e409 <= lohi0_.x) ? 1.0 : ((_e404 > lohi0_.y) ? 0.0 : _e403);
+            float _e414 = vis1_;
+            float _e415 = d;
+            float _e420 = d;
+            vis1_ = (_e420 <= lohi1_.x) ? 1.0 : ((_e415 > lohi1_.y) ? 0.0 : _e414);
+            bool _e426 = done0_;
+            if (!(_e426)) {
+                float _e429 = total0_;
+                float _e430 = weight0_;
+                float _e431 = vis0_;
+                total0_ = _e429 + (_e430 * metal::clamp(_e431, 0.0, 1.0));
             }
-            bool _e432 = done1_;
-            if (!(_e432)) {
-                float _e435 = total1_;
-                float _e436 = weight1_;
-                float _e437 = vis1_;
-                total1_ = _e435 + (_e436 * metal::clamp(_e437, 0.0, 1.0));
+            bool _e438 = done1_;
+            if (!(_e438)) {
+                float _e441 = total1_;
+                float _e442 = weight1_;
+                float _e443 = vis1_;
+                total1_ = _e441 + (_e442 * metal::clamp(_e443, 0.0, 1.0));
             }
-            bool _e443 = done0_;
-            if (!(_e443)) {
+            bool _e449 = done0_;
+            if (!(_e449)) {
                 local_7 = is_last0_;
             } else {
                 local_7 = true;
             }
-            bool _e448 = local_7;
-            done0_ = _e448;
-            bool _e449 = done1_;
-            if (!(_e449)) {
+            bool _e454 = local_7;
+            done0_ = _e454;
+            bool _e455 = done1_;
+            if (!(_e455)) {
                 local_8 = is_last1_;
             } else {
                 local_8 = true;
             }
-            bool _e454 = local_8;
-            done1_ = _e454;
-            bool _e455 = done0_;
-            if (_e455) {
-                bool _e456 = done1_;
-                local_9 = _e456;
+            bool _e460 = local_8;
+            done1_ = _e460;
+            bool _e461 = done0_;
+            if (_e461) {
+                bool _e462 = done1_;
+                local_9 = _e462;
             } else {
                 local_9 = false;
             }
-            bool _e460 = local_9;
-            if (_e460) {
+            bool _e466 = local_9;
+            if (_e466) {
                 break;
             }
         }
     }
-    float _e466 = total0_;
-    float _e468 = total1_;
-    float l_2 = ((1.0 - w1_) * _e466) + (w1_ * _e468);
+    float _e472 = total0_;
+    float _e474 = total1_;
+    float l_2 = ((1.0 - w1_) * _e472) + (w1_ * _e474);
     metal::float3 c = color * l_2;
     return c;
 }

@@ -58,6 +58,7 @@ const PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX: f32 = 3.1415927f;
 const GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX: vec4<f32> = vec4<f32>(-0.8611363f, -0.33998105f, 0.33998105f, 0.8611363f);
 const GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX: vec4<f32> = vec4<f32>(0.34785485f, 0.65214515f, 0.65214515f, 0.34785485f);
 const DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX: f32 = 0.1f;
+const STRIDE: u32 = 1u;
 const REGIONS: u32 = 4u;
 const LAYERS: u32 = 8u;
 
@@ -437,9 +438,9 @@ fn bounds_index(x_3: u32, row: u32) -> u32 {
 }
 
 fn filtered_index(x_4: u32, row_1: u32, layer_1: u32) -> u32 {
-    let _e5 = frame.sizes.z;
-    let _e12 = frame.sizes.w;
-    return ((((layer_1 * _e5) + x_4) * _e12) + row_1);
+    let _e3 = frame.sizes.z;
+    let _e14 = frame.sizes.w;
+    return ((((layer_1 * (_e3 / STRIDE)) + x_4) * _e14) + row_1);
 }
 
 fn encode_layer(v_10: vec4<f32>) -> u32 {
@@ -509,150 +510,150 @@ fn scatter_pixel(x_6: u32, y_1: u32) -> vec3<f32> {
     }
     let axis = f_12.axis.xyz;
     let rows_2 = f_12.sizes.w;
-    let width_1 = f_12.sizes.z;
+    let width_1 = (f_12.sizes.z / STRIDE);
     let wrap_1 = (f_12.anti_epipole.w > 0.5f);
     {
         theta_3 = acos(clamp(dot(_e10, axis), -1f, 1f));
-        let _e59 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, _e10);
-        yc = _e59;
-        let _e61 = theta_3;
-        let _e66 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e61, f_12.theta.x, f_12.theta.y);
-        d = _e66;
-        let _e68 = theta_3;
-        let _e69 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, _e10, s_3, _e68, false);
-        reach = _e69;
+        let _e61 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, _e10);
+        yc = _e61;
+        let _e63 = theta_3;
+        let _e68 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e63, f_12.theta.x, f_12.theta.y);
+        d = _e68;
+        let _e70 = theta_3;
+        let _e71 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, _e10, s_3, _e70, false);
+        reach = _e71;
     }
-    let _e71 = yc;
-    let yb = (_e71 - 0.5f);
+    let _e73 = yc;
+    let yb = (_e73 - 0.5f);
     let fy = (yb - floor(yb));
-    let _e77 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(yb), rows_2, wrap_1);
-    let _e81 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX((floor(yb) + 1f), rows_2, wrap_1);
-    let row1_ = select(_e77, _e81, (yb > floor(yb)));
-    let w1_ = select(0f, fy, (row1_ != _e77));
+    let _e79 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(yb), rows_2, wrap_1);
+    let _e83 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX((floor(yb) + 1f), rows_2, wrap_1);
+    let row1_ = select(_e79, _e83, (yb > floor(yb)));
+    let w1_ = select(0f, fy, (row1_ != _e79));
     let cos_theta_l = -(dot(f_12.light_dir.xyz, _e10));
     let panels_2 = max((f_12.sizes2_.z / 4u), 1u);
-    let _e99 = d;
-    let _e103 = d;
-    angle = vec2<f32>(sin((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e99)), cos((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e103)));
-    let _e108 = angle;
-    let _e109 = fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e108);
+    let _e101 = d;
+    let _e105 = d;
+    angle = vec2<f32>(sin((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e101)), cos((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e105)));
+    let _e110 = angle;
+    let _e111 = fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e110);
     loop {
-        let _e111 = layer_3;
-        if (_e111 < LAYERS) {
+        let _e113 = layer_3;
+        if (_e113 < LAYERS) {
         } else {
             break;
         }
         {
-            let _e114 = angle;
-            let _e115 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e114, _e109);
-            let _e117 = layer_3;
-            let _e119 = angle;
-            let _e120 = layer_3;
-            let _e121 = coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e119, _e115, _e120);
-            coeffs[_e117] = _e121;
-            let _e122 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e115, _e109);
-            angle = _e122;
+            let _e116 = angle;
+            let _e117 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e116, _e111);
+            let _e119 = layer_3;
+            let _e121 = angle;
+            let _e122 = layer_3;
+            let _e123 = coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e121, _e117, _e122);
+            coeffs[_e119] = _e123;
+            let _e124 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e117, _e111);
+            angle = _e124;
         }
         continuing {
-            let _e124 = layer_3;
-            layer_3 = (_e124 + 1u);
+            let _e126 = layer_3;
+            layer_3 = (_e126 + 1u);
         }
     }
-    let _e130 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.z, cos_theta_l);
-    let sun_scatter = (f_12.medium.y * _e130);
-    let _e133 = xs;
-    xs0_ = _e133;
+    let _e132 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.z, cos_theta_l);
+    let sun_scatter = (f_12.medium.y * _e132);
     let _e135 = xs;
-    xs1_ = _e135;
+    xs0_ = _e135;
+    let _e137 = xs;
+    xs1_ = _e137;
     {
-        let _e139 = slices[_e77];
-        let _e140 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e139);
-        delta0_ = _e140.delta;
-        let _e145 = slices[row1_];
-        let _e146 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e145);
-        delta1_ = _e146.delta;
-        let _e149 = reach;
-        let _e150 = delta0_;
-        xs0_ = (_e149 / _e150);
-        let _e152 = reach;
-        let _e153 = delta1_;
-        xs1_ = (_e152 / _e153);
+        let _e141 = slices[_e79];
+        let _e142 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e141);
+        delta0_ = (1f * _e142.delta);
+        let _e149 = slices[row1_];
+        let _e150 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e149);
+        delta1_ = (1f * _e150.delta);
+        let _e155 = reach;
+        let _e156 = delta0_;
+        xs0_ = (_e155 / _e156);
+        let _e158 = reach;
+        let _e159 = delta1_;
+        xs1_ = (_e158 / _e159);
     }
-    let _e155 = xs0_;
-    let last0_ = u32(min(max(_e155, 0f), (f32(width_1) - 1f)));
-    let _e163 = xs1_;
-    let last1_ = u32(min(max(_e163, 0f), (f32(width_1) - 1f)));
+    let _e161 = xs0_;
+    let last0_ = u32(min(max(_e161, 0f), (f32(width_1) - 1f)));
+    let _e169 = xs1_;
+    let last1_ = u32(min(max(_e169, 0f), (f32(width_1) - 1f)));
     loop {
-        let _e173 = r_1;
-        if (_e173 < REGIONS) {
+        let _e179 = r_1;
+        if (_e179 < REGIONS) {
         } else {
             break;
         }
         {
-            let _e175 = r_1;
-            let _e176 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e175, REGIONS, width_1, false);
-            let b0_ = f32(_e176);
-            let _e178 = r_1;
-            let _e181 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e178 + 1u), REGIONS, width_1, false);
-            let b1_ = f32(_e181);
+            let _e181 = r_1;
+            let _e182 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e181, REGIONS, width_1, false);
+            let b0_ = f32(_e182);
+            let _e184 = r_1;
+            let _e187 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e184 + 1u), REGIONS, width_1, false);
+            let b1_ = f32(_e187);
             if !((last0_ < u32(b1_))) {
-                let _e186 = r_1;
-                local_2 = ((_e186 + 1u) == REGIONS);
+                let _e192 = r_1;
+                local_2 = ((_e192 + 1u) == REGIONS);
             } else {
                 local_2 = true;
             }
             let is_last0_ = local_2;
             if !((last1_ < u32(b1_))) {
-                let _e197 = r_1;
-                local_3 = ((_e197 + 1u) == REGIONS);
+                let _e203 = r_1;
+                local_3 = ((_e203 + 1u) == REGIONS);
             } else {
                 local_3 = true;
             }
             let is_last1_ = local_3;
-            let _e207 = xs0_;
-            let pos0_ = select((b1_ - 0.5f), clamp((_e207 - 0.5f), (b0_ + 0.5f), (b1_ - 0.5f)), is_last0_);
-            let _e218 = xs1_;
-            let pos1_ = select((b1_ - 0.5f), clamp((_e218 - 0.5f), (b0_ + 0.5f), (b1_ - 0.5f)), is_last1_);
+            let _e213 = xs0_;
+            let pos0_ = select((b1_ - 0.5f), clamp((_e213 - 0.5f), (b0_ + 0.5f), (b1_ - 0.5f)), is_last0_);
+            let _e224 = xs1_;
+            let pos1_ = select((b1_ - 0.5f), clamp((_e224 - 0.5f), (b0_ + 0.5f), (b1_ - 0.5f)), is_last1_);
             a0_ = f32();
             e0_ = f32();
             a1_ = f32();
             e1_ = f32();
-            let _e235 = delta0_;
-            let _e236 = theta_3;
-            let _e237 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b0_, _e235, _e236, s_3, false);
-            a0_ = _e237;
-            let _e238 = delta0_;
-            let _e239 = theta_3;
-            let _e240 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b1_, _e238, _e239, s_3, false);
-            e0_ = select(_e240, s_3, is_last0_);
-            let _e242 = delta1_;
-            let _e243 = theta_3;
-            let _e244 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b0_, _e242, _e243, s_3, false);
-            a1_ = _e244;
-            let _e245 = delta1_;
-            let _e246 = theta_3;
-            let _e247 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b1_, _e245, _e246, s_3, false);
-            e1_ = select(_e247, s_3, is_last1_);
+            let _e241 = delta0_;
+            let _e242 = theta_3;
+            let _e243 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b0_, _e241, _e242, s_3, false);
+            a0_ = _e243;
+            let _e244 = delta0_;
+            let _e245 = theta_3;
+            let _e246 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b1_, _e244, _e245, s_3, false);
+            e0_ = select(_e246, s_3, is_last0_);
+            let _e248 = delta1_;
+            let _e249 = theta_3;
+            let _e250 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b0_, _e248, _e249, s_3, false);
+            a1_ = _e250;
+            let _e251 = delta1_;
+            let _e252 = theta_3;
+            let _e253 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b1_, _e251, _e252, s_3, false);
+            e1_ = select(_e253, s_3, is_last1_);
             weight0_ = f32();
             weight1_ = f32();
             if false {
-                let _e253 = a0_;
-                let _e254 = e0_;
-                let _e255 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, _e10, _e253, _e254, panels_2);
-                weight0_ = _e255;
-                let _e256 = a1_;
-                let _e257 = e1_;
-                let _e258 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, _e10, _e256, _e257, panels_2);
-                weight1_ = _e258;
+                let _e259 = a0_;
+                let _e260 = e0_;
+                let _e261 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, _e10, _e259, _e260, panels_2);
+                weight0_ = _e261;
+                let _e262 = a1_;
+                let _e263 = e1_;
+                let _e264 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, _e10, _e262, _e263, panels_2);
+                weight1_ = _e264;
             } else {
-                let _e261 = a0_;
-                let _e262 = e0_;
-                let _e263 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.x, _e261, _e262);
-                weight0_ = (sun_scatter * _e263);
-                let _e267 = a1_;
-                let _e268 = e1_;
+                let _e267 = a0_;
+                let _e268 = e0_;
                 let _e269 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.x, _e267, _e268);
-                weight1_ = (sun_scatter * _e269);
+                weight0_ = (sun_scatter * _e269);
+                let _e273 = a1_;
+                let _e274 = e1_;
+                let _e275 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.x, _e273, _e274);
+                weight1_ = (sun_scatter * _e275);
             }
             let xb0_ = (pos0_ - 0.5f);
             let fx0_ = (xb0_ - floor(xb0_));
@@ -662,142 +663,142 @@ fn scatter_pixel(x_6: u32, y_1: u32) -> vec3<f32> {
             let fx1_ = (xb1_ - floor(xb1_));
             let x10_ = u32(clamp(floor(xb1_), 0f, (f32(width_1) - 1f)));
             let x11_ = select(x10_, min((x10_ + 1u), (width_1 - 1u)), (xb1_ > floor(xb1_)));
-            let _e309 = bounds_index(x01_, _e77);
-            let lohi0_ = bounds[_e309];
-            let _e313 = bounds_index(x11_, row1_);
-            let lohi1_ = bounds[_e313];
+            let _e315 = bounds_index(x01_, _e79);
+            let lohi0_ = bounds[_e315];
+            let _e319 = bounds_index(x11_, row1_);
+            let lohi1_ = bounds[_e319];
             vis0_ = 0.5f;
             vis1_ = 0.5f;
-            let _e321 = d;
-            if (_e321 > lohi0_.x) {
-                let _e324 = d;
-                local_4 = (_e324 <= lohi0_.y);
+            let _e327 = d;
+            if (_e327 > lohi0_.x) {
+                let _e330 = d;
+                local_4 = (_e330 <= lohi0_.y);
             } else {
                 local_4 = false;
             }
-            let _e330 = local_4;
-            if !(_e330) {
-                let _e332 = d;
-                if (_e332 > lohi1_.x) {
-                    let _e335 = d;
-                    local_6 = (_e335 <= lohi1_.y);
+            let _e336 = local_4;
+            if !(_e336) {
+                let _e338 = d;
+                if (_e338 > lohi1_.x) {
+                    let _e341 = d;
+                    local_6 = (_e341 <= lohi1_.y);
                 } else {
                     local_6 = false;
                 }
-                let _e341 = local_6;
-                local_5 = _e341;
+                let _e347 = local_6;
+                local_5 = _e347;
             } else {
                 local_5 = true;
             }
-            let _e345 = local_5;
-            if _e345 {
+            let _e351 = local_5;
+            if _e351 {
                 layer_4 = 0u;
                 loop {
-                    let _e348 = layer_4;
-                    if (_e348 < LAYERS) {
+                    let _e354 = layer_4;
+                    if (_e354 < LAYERS) {
                     } else {
                         break;
                     }
                     {
-                        let _e351 = layer_4;
-                        let coeff = coeffs[_e351];
-                        let _e354 = layer_4;
-                        let _e355 = filtered_load(x00_, _e77, _e354);
-                        let _e356 = layer_4;
-                        let _e357 = filtered_load(x01_, _e77, _e356);
-                        let texel0_ = mix(_e355, _e357, fx0_);
-                        let _e359 = layer_4;
-                        let _e360 = filtered_load(x10_, row1_, _e359);
-                        let _e361 = layer_4;
-                        let _e362 = filtered_load(x11_, row1_, _e361);
-                        let texel1_ = mix(_e360, _e362, fx1_);
+                        let _e357 = layer_4;
+                        let coeff = coeffs[_e357];
+                        let _e360 = layer_4;
+                        let _e361 = filtered_load(x00_, _e79, _e360);
+                        let _e362 = layer_4;
+                        let _e363 = filtered_load(x01_, _e79, _e362);
+                        let texel0_ = mix(_e361, _e363, fx0_);
+                        let _e365 = layer_4;
+                        let _e366 = filtered_load(x10_, row1_, _e365);
+                        let _e367 = layer_4;
+                        let _e368 = filtered_load(x11_, row1_, _e367);
+                        let texel1_ = mix(_e366, _e368, fx1_);
                         k_3 = 0u;
                         loop {
-                            let _e366 = k_3;
-                            if (_e366 < 4u) {
+                            let _e372 = k_3;
+                            if (_e372 < 4u) {
                             } else {
                                 break;
                             }
                             {
-                                let _e369 = vis0_;
-                                let _e370 = k_3;
-                                let _e372 = k_3;
-                                vis0_ = (_e369 + (coeff[_e370] * ((texel0_[_e372] * 2f) - 1f)));
-                                let _e380 = vis1_;
-                                let _e381 = k_3;
-                                let _e383 = k_3;
-                                vis1_ = (_e380 + (coeff[_e381] * ((texel1_[_e383] * 2f) - 1f)));
+                                let _e375 = vis0_;
+                                let _e376 = k_3;
+                                let _e378 = k_3;
+                                vis0_ = (_e375 + (coeff[_e376] * ((texel0_[_e378] * 2f) - 1f)));
+                                let _e386 = vis1_;
+                                let _e387 = k_3;
+                                let _e389 = k_3;
+                                vis1_ = (_e386 + (coeff[_e387] * ((texel1_[_e389] * 2f) - 1f)));
                             }
                             continuing {
-                                let _e392 = k_3;
-                                k_3 = (_e392 + 1u);
+                                let _e398 = k_3;
+                                k_3 = (_e398 + 1u);
                             }
                         }
                     }
                     continuing {
-                        let _e395 = layer_4;
-                        layer_4 = (_e395 + 1u);
+                        let _e401 = layer_4;
+                        layer_4 = (_e401 + 1u);
                     }
                 }
             }
-            let _e397 = vis0_;
-            let _e398 = d;
-            let _e403 = d;
-            vis0_ = select(select(_e397, 0f, (_e398 > lohi0_.y)), 1f, (_e403 <= lohi0_.x));
-            let _e408 = vis1_;
+            let _e403 = vis0_;
+            let _e404 = d;
             let _e409 = d;
-            let _e414 = d;
-            vis1_ = select(select(_e408, 0f, (_e409 > lohi1_.y)), 1f, (_e414 <= lohi1_.x));
-            let _e420 = done0_;
-            if !(_e420) {
-                let _e423 = total0_;
-                let _e424 = weight0_;
-                let _e425 = vis0_;
-                total0_ = (_e423 + (_e424 * clamp(_e425, 0f, 1f)));
+            vis0_ = select(select(_e403, 0f, (_e404 > lohi0_.y)), 1f, (_e409 <= lohi0_.x));
+            let _e414 = vis1_;
+            let _e415 = d;
+            let _e420 = d;
+            vis1_ = select(select(_e414, 0f, (_e415 > lohi1_.y)), 1f, (_e420 <= lohi1_.x));
+            let _e426 = done0_;
+            if !(_e426) {
+                let _e429 = total0_;
+                let _e430 = weight0_;
+                let _e431 = vis0_;
+                total0_ = (_e429 + (_e430 * clamp(_e431, 0f, 1f)));
             }
-            let _e432 = done1_;
-            if !(_e432) {
-                let _e435 = total1_;
-                let _e436 = weight1_;
-                let _e437 = vis1_;
-                total1_ = (_e435 + (_e436 * clamp(_e437, 0f, 1f)));
+            let _e438 = done1_;
+            if !(_e438) {
+                let _e441 = total1_;
+                let _e442 = weight1_;
+                let _e443 = vis1_;
+                total1_ = (_e441 + (_e442 * clamp(_e443, 0f, 1f)));
             }
-            let _e443 = done0_;
-            if !(_e443) {
+            let _e449 = done0_;
+            if !(_e449) {
                 local_7 = is_last0_;
             } else {
                 local_7 = true;
             }
-            let _e448 = local_7;
-            done0_ = _e448;
-            let _e449 = done1_;
-            if !(_e449) {
+            let _e454 = local_7;
+            done0_ = _e454;
+            let _e455 = done1_;
+            if !(_e455) {
                 local_8 = is_last1_;
             } else {
                 local_8 = true;
             }
-            let _e454 = local_8;
-            done1_ = _e454;
-            let _e455 = done0_;
-            if _e455 {
-                let _e456 = done1_;
-                local_9 = _e456;
+            let _e460 = local_8;
+            done1_ = _e460;
+            let _e461 = done0_;
+            if _e461 {
+                let _e462 = done1_;
+                local_9 = _e462;
             } else {
                 local_9 = false;
             }
-            let _e460 = local_9;
-            if _e460 {
+            let _e466 = local_9;
+            if _e466 {
                 break;
             }
         }
         continuing {
-            let _e462 = r_1;
-            r_1 = (_e462 + 1u);
+            let _e468 = r_1;
+            r_1 = (_e468 + 1u);
         }
     }
-    let _e466 = total0_;
-    let _e468 = total1_;
-    let l_2 = (((1f - w1_) * _e466) + (w1_ * _e468));
+    let _e472 = total0_;
+    let _e474 = total1_;
+    let l_2 = (((1f - w1_) * _e472) + (w1_ * _e474));
     let c = (color * l_2);
     return c;
 }

@@ -66,6 +66,7 @@ static const float DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX = 0
 static const float MOMENT_BIAS_6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX = 0.0003;
 static const float FAR_ROOTX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX = 10000.0;
 static const float MOMENT_SPLITX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX = 0.5;
+static const uint STRIDE = 1u;
 static const uint REGIONS = 4u;
 
 cbuffer frame : register(b0) { FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX frame; }
@@ -683,8 +684,8 @@ uint bounds_index(uint x_6, uint row)
 uint filtered_index(uint x_7, uint row_1, uint layer)
 {
     uint _e5 = frame.sizes.w;
-    uint _e12 = frame.sizes.z;
-    return ((((layer * _e5) + row_1) * _e12) + x_7);
+    uint _e11 = frame.sizes.z;
+    return ((((layer * _e5) + row_1) * naga_div(_e11, STRIDE)) + x_7);
 }
 
 float4 encode_layer(float4 v_11)
@@ -756,134 +757,134 @@ float3 scatter_pixel(uint x_9, uint y_1)
     }
     float3 axis = f_13.axis.xyz;
     uint rows_2 = f_13.sizes.w;
-    uint width_1 = f_13.sizes.z;
+    uint width_1 = naga_div(f_13.sizes.z, STRIDE);
     bool wrap_1 = (f_13.anti_epipole.w > 0.5);
     {
         theta_3 = acos(clamp(dot(_e10, axis), -1.0, 1.0));
-        const float _e59 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, _e10);
-        yc = _e59;
-        float _e61 = theta_3;
-        const float _e66 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e61, f_13.theta.x, f_13.theta.y);
-        d_1 = _e66;
-        float _e68 = theta_3;
-        const float _e69 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, _e10, s_5, _e68, false);
-        reach = _e69;
+        const float _e61 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, _e10);
+        yc = _e61;
+        float _e63 = theta_3;
+        const float _e68 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e63, f_13.theta.x, f_13.theta.y);
+        d_1 = _e68;
+        float _e70 = theta_3;
+        const float _e71 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, _e10, s_5, _e70, false);
+        reach = _e71;
     }
-    float _e71 = yc;
-    float yb = (_e71 - 0.5);
+    float _e73 = yc;
+    float yb = (_e73 - 0.5);
     float fy = (yb - floor(yb));
-    const uint _e77 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(yb), rows_2, wrap_1);
-    const uint _e81 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX((floor(yb) + 1.0), rows_2, wrap_1);
-    uint row1_ = ((yb > floor(yb)) ? _e81 : _e77);
-    float w1_ = ((row1_ != _e77) ? fy : 0.0);
+    const uint _e79 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(yb), rows_2, wrap_1);
+    const uint _e83 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX((floor(yb) + 1.0), rows_2, wrap_1);
+    uint row1_ = ((yb > floor(yb)) ? _e83 : _e79);
+    float w1_ = ((row1_ != _e79) ? fy : 0.0);
     float cos_theta_l = -(dot(f_13.light_dir.xyz, _e10));
     uint panels_2 = max(naga_div(f_13.sizes2_.z, 4u), 1u);
-    float _e98 = d_1;
-    const float _e99 = moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(_e98);
-    const float _e104 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.z, cos_theta_l);
-    float sun_scatter = (f_13.medium.y * _e104);
-    float _e107 = xs;
-    xs0_ = _e107;
+    float _e100 = d_1;
+    const float _e101 = moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(_e100);
+    const float _e106 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.z, cos_theta_l);
+    float sun_scatter = (f_13.medium.y * _e106);
     float _e109 = xs;
-    xs1_ = _e109;
+    xs0_ = _e109;
+    float _e111 = xs;
+    xs1_ = _e111;
     {
-        float4 _e113 = asfloat(slices.Load4(_e77*16));
-        const SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e114 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e113);
-        delta0_ = _e114.delta;
-        float4 _e119 = asfloat(slices.Load4(row1_*16));
-        const SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e120 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e119);
-        delta1_ = _e120.delta;
-        float _e123 = reach;
-        float _e124 = delta0_;
-        xs0_ = (_e123 / _e124);
-        float _e126 = reach;
-        float _e127 = delta1_;
-        xs1_ = (_e126 / _e127);
+        float4 _e115 = asfloat(slices.Load4(_e79*16));
+        const SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e116 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e115);
+        delta0_ = (1.0 * _e116.delta);
+        float4 _e123 = asfloat(slices.Load4(row1_*16));
+        const SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e124 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e123);
+        delta1_ = (1.0 * _e124.delta);
+        float _e129 = reach;
+        float _e130 = delta0_;
+        xs0_ = (_e129 / _e130);
+        float _e132 = reach;
+        float _e133 = delta1_;
+        xs1_ = (_e132 / _e133);
     }
-    float _e129 = xs0_;
-    uint last0_ = naga_f2u32(min(max(_e129, 0.0), (float(width_1) - 1.0)));
-    float _e137 = xs1_;
-    uint last1_ = naga_f2u32(min(max(_e137, 0.0), (float(width_1) - 1.0)));
+    float _e135 = xs0_;
+    uint last0_ = naga_f2u32(min(max(_e135, 0.0), (float(width_1) - 1.0)));
+    float _e143 = xs1_;
+    uint last1_ = naga_f2u32(min(max(_e143, 0.0), (float(width_1) - 1.0)));
     uint2 loop_bound_4 = uint2(4294967295u, 4294967295u);
     bool loop_init_4 = true;
     while(true) {
         if (all(loop_bound_4 == uint2(0u, 0u))) { break; }
         loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
         if (!loop_init_4) {
-            uint _e404 = r_1;
-            r_1 = (_e404 + 1u);
+            uint _e410 = r_1;
+            r_1 = (_e410 + 1u);
         }
         loop_init_4 = false;
-        uint _e147 = r_1;
-        if ((_e147 < REGIONS)) {
+        uint _e153 = r_1;
+        if ((_e153 < REGIONS)) {
         } else {
             break;
         }
         {
-            uint _e149 = r_1;
-            const uint _e150 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e149, REGIONS, width_1, false);
-            float b0_ = float(_e150);
-            uint _e152 = r_1;
-            const uint _e155 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e152 + 1u), REGIONS, width_1, false);
-            float b1_2 = float(_e155);
+            uint _e155 = r_1;
+            const uint _e156 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e155, REGIONS, width_1, false);
+            float b0_ = float(_e156);
+            uint _e158 = r_1;
+            const uint _e161 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e158 + 1u), REGIONS, width_1, false);
+            float b1_2 = float(_e161);
             if (!((last0_ < naga_f2u32(b1_2)))) {
-                uint _e160 = r_1;
-                local_3 = ((_e160 + 1u) == REGIONS);
+                uint _e166 = r_1;
+                local_3 = ((_e166 + 1u) == REGIONS);
             } else {
                 local_3 = true;
             }
             bool is_last0_ = local_3;
             if (!((last1_ < naga_f2u32(b1_2)))) {
-                uint _e171 = r_1;
-                local_4 = ((_e171 + 1u) == REGIONS);
+                uint _e177 = r_1;
+                local_4 = ((_e177 + 1u) == REGIONS);
             } else {
                 local_4 = true;
             }
             bool is_last1_ = local_4;
-            float _e181 = xs0_;
-            float pos0_ = (is_last0_ ? clamp((_e181 - 0.5), (b0_ + 0.5), (b1_2 - 0.5)) : (b1_2 - 0.5));
-            float _e192 = xs1_;
-            float pos1_ = (is_last1_ ? clamp((_e192 - 0.5), (b0_ + 0.5), (b1_2 - 0.5)) : (b1_2 - 0.5));
+            float _e187 = xs0_;
+            float pos0_ = (is_last0_ ? clamp((_e187 - 0.5), (b0_ + 0.5), (b1_2 - 0.5)) : (b1_2 - 0.5));
+            float _e198 = xs1_;
+            float pos1_ = (is_last1_ ? clamp((_e198 - 0.5), (b0_ + 0.5), (b1_2 - 0.5)) : (b1_2 - 0.5));
             a0_ = ZeroValuefloat();
             e0_ = ZeroValuefloat();
             a1_ = ZeroValuefloat();
             e1_ = ZeroValuefloat();
-            float _e209 = delta0_;
-            float _e210 = theta_3;
-            const float _e211 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b0_, _e209, _e210, s_5, false);
-            a0_ = _e211;
-            float _e212 = delta0_;
-            float _e213 = theta_3;
-            const float _e214 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b1_2, _e212, _e213, s_5, false);
-            e0_ = (is_last0_ ? s_5 : _e214);
-            float _e216 = delta1_;
-            float _e217 = theta_3;
-            const float _e218 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b0_, _e216, _e217, s_5, false);
-            a1_ = _e218;
-            float _e219 = delta1_;
-            float _e220 = theta_3;
-            const float _e221 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b1_2, _e219, _e220, s_5, false);
-            e1_ = (is_last1_ ? s_5 : _e221);
+            float _e215 = delta0_;
+            float _e216 = theta_3;
+            const float _e217 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b0_, _e215, _e216, s_5, false);
+            a0_ = _e217;
+            float _e218 = delta0_;
+            float _e219 = theta_3;
+            const float _e220 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b1_2, _e218, _e219, s_5, false);
+            e0_ = (is_last0_ ? s_5 : _e220);
+            float _e222 = delta1_;
+            float _e223 = theta_3;
+            const float _e224 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b0_, _e222, _e223, s_5, false);
+            a1_ = _e224;
+            float _e225 = delta1_;
+            float _e226 = theta_3;
+            const float _e227 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b1_2, _e225, _e226, s_5, false);
+            e1_ = (is_last1_ ? s_5 : _e227);
             weight0_ = ZeroValuefloat();
             weight1_ = ZeroValuefloat();
             if (false) {
-                float _e227 = a0_;
-                float _e228 = e0_;
-                const float _e229 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, _e10, _e227, _e228, panels_2);
-                weight0_ = _e229;
-                float _e230 = a1_;
-                float _e231 = e1_;
-                const float _e232 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, _e10, _e230, _e231, panels_2);
-                weight1_ = _e232;
+                float _e233 = a0_;
+                float _e234 = e0_;
+                const float _e235 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, _e10, _e233, _e234, panels_2);
+                weight0_ = _e235;
+                float _e236 = a1_;
+                float _e237 = e1_;
+                const float _e238 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, _e10, _e236, _e237, panels_2);
+                weight1_ = _e238;
             } else {
-                float _e235 = a0_;
-                float _e236 = e0_;
-                const float _e237 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.x, _e235, _e236);
-                weight0_ = (sun_scatter * _e237);
-                float _e241 = a1_;
-                float _e242 = e1_;
+                float _e241 = a0_;
+                float _e242 = e0_;
                 const float _e243 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.x, _e241, _e242);
-                weight1_ = (sun_scatter * _e243);
+                weight0_ = (sun_scatter * _e243);
+                float _e247 = a1_;
+                float _e248 = e1_;
+                const float _e249 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.x, _e247, _e248);
+                weight1_ = (sun_scatter * _e249);
             }
             float xb0_ = (pos0_ - 0.5);
             float fx0_ = (xb0_ - floor(xb0_));
@@ -893,102 +894,102 @@ float3 scatter_pixel(uint x_9, uint y_1)
             float fx1_ = (xb1_ - floor(xb1_));
             uint x10_ = naga_f2u32(clamp(floor(xb1_), 0.0, (float(width_1) - 1.0)));
             uint x11_ = ((xb1_ > floor(xb1_)) ? min((x10_ + 1u), (width_1 - 1u)) : x10_);
-            const uint _e283 = bounds_index(x01_, _e77);
-            float2 lohi0_ = asfloat(bounds.Load2(_e283*8));
-            const uint _e287 = bounds_index(x11_, row1_);
-            float2 lohi1_ = asfloat(bounds.Load2(_e287*8));
+            const uint _e289 = bounds_index(x01_, _e79);
+            float2 lohi0_ = asfloat(bounds.Load2(_e289*8));
+            const uint _e293 = bounds_index(x11_, row1_);
+            float2 lohi1_ = asfloat(bounds.Load2(_e293*8));
             vis0_ = 0.5;
             vis1_ = 0.5;
-            float _e295 = d_1;
-            if ((_e295 > lohi0_.x)) {
-                float _e298 = d_1;
-                local_5 = (_e298 <= lohi0_.y);
+            float _e301 = d_1;
+            if ((_e301 > lohi0_.x)) {
+                float _e304 = d_1;
+                local_5 = (_e304 <= lohi0_.y);
             } else {
                 local_5 = false;
             }
-            bool _e304 = local_5;
-            if (_e304) {
-                const float4 _e306 = filtered_load(x00_, _e77, 0u);
-                const float4 _e308 = filtered_load(x01_, _e77, 0u);
-                float4 m0_ = lerp(_e306, _e308, fx0_);
-                const float4 _e311 = filtered_load(x00_, _e77, 1u);
-                const float4 _e313 = filtered_load(x01_, _e77, 1u);
-                float4 m1_ = lerp(_e311, _e313, fx0_);
-                const float _e316 = lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(m0_, m1_.xy, _e99);
-                vis0_ = _e316;
+            bool _e310 = local_5;
+            if (_e310) {
+                const float4 _e312 = filtered_load(x00_, _e79, 0u);
+                const float4 _e314 = filtered_load(x01_, _e79, 0u);
+                float4 m0_ = lerp(_e312, _e314, fx0_);
+                const float4 _e317 = filtered_load(x00_, _e79, 1u);
+                const float4 _e319 = filtered_load(x01_, _e79, 1u);
+                float4 m1_ = lerp(_e317, _e319, fx0_);
+                const float _e322 = lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(m0_, m1_.xy, _e101);
+                vis0_ = _e322;
             }
-            float _e317 = d_1;
-            if ((_e317 > lohi1_.x)) {
-                float _e320 = d_1;
-                local_6 = (_e320 <= lohi1_.y);
+            float _e323 = d_1;
+            if ((_e323 > lohi1_.x)) {
+                float _e326 = d_1;
+                local_6 = (_e326 <= lohi1_.y);
             } else {
                 local_6 = false;
             }
-            bool _e326 = local_6;
-            if (_e326) {
-                const float4 _e328 = filtered_load(x10_, row1_, 0u);
-                const float4 _e330 = filtered_load(x11_, row1_, 0u);
-                float4 m0_1 = lerp(_e328, _e330, fx1_);
-                const float4 _e333 = filtered_load(x10_, row1_, 1u);
-                const float4 _e335 = filtered_load(x11_, row1_, 1u);
-                float4 m1_1 = lerp(_e333, _e335, fx1_);
-                const float _e338 = lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(m0_1, m1_1.xy, _e99);
-                vis1_ = _e338;
+            bool _e332 = local_6;
+            if (_e332) {
+                const float4 _e334 = filtered_load(x10_, row1_, 0u);
+                const float4 _e336 = filtered_load(x11_, row1_, 0u);
+                float4 m0_1 = lerp(_e334, _e336, fx1_);
+                const float4 _e339 = filtered_load(x10_, row1_, 1u);
+                const float4 _e341 = filtered_load(x11_, row1_, 1u);
+                float4 m1_1 = lerp(_e339, _e341, fx1_);
+                const float _e344 = lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(m0_1, m1_1.xy, _e101);
+                vis1_ = _e344;
             }
-            float _e339 = vis0_;
-            float _e340 = d_1;
-            float _e345 = d_1;
-            vis0_ = ((_e345 <= lohi0_.x) ? 1.0 : ((_e340 > lohi0_.y) ? 0.0 : _e339));
-            float _e350 = vis1_;
+            float _e345 = vis0_;
+            float _e346 = d_1;
             float _e351 = d_1;
-            float _e356 = d_1;
-            vis1_ = ((_e356 <= lohi1_.x) ? 1.0 : ((_e351 > lohi1_.y) ? 0.0 : _e350));
-            bool _e362 = done0_;
-            if (!(_e362)) {
-                float _e365 = total0_;
-                float _e366 = weight0_;
-                float _e367 = vis0_;
-                total0_ = (_e365 + (_e366 * clamp(_e367, 0.0, 1.0)));
+            vis0_ = ((_e351 <= lohi0_.x) ? 1.0 : ((_e346 > lohi0_.y) ? 0.0 : _e345));
+            float _e356 = vis1_;
+            float _e357 = d_1;
+            float _e362 = d_1;
+            vis1_ = ((_e362 <= lohi1_.x) ? 1.0 : ((_e357 > lohi1_.y) ? 0.0 : _e356));
+            bool _e368 = done0_;
+            if (!(_e368)) {
+                float _e371 = total0_;
+                float _e372 = weight0_;
+                float _e373 = vis0_;
+                total0_ = (_e371 + (_e372 * clamp(_e373, 0.0, 1.0)));
             }
-            bool _e374 = done1_;
-            if (!(_e374)) {
-                float _e377 = total1_;
-                float _e378 = weight1_;
-                float _e379 = vis1_;
-                total1_ = (_e377 + (_e378 * clamp(_e379, 0.0, 1.0)));
+            bool _e380 = done1_;
+            if (!(_e380)) {
+                float _e383 = total1_;
+                float _e384 = weight1_;
+                float _e385 = vis1_;
+                total1_ = (_e383 + (_e384 * clamp(_e385, 0.0, 1.0)));
             }
-            bool _e385 = done0_;
-            if (!(_e385)) {
+            bool _e391 = done0_;
+            if (!(_e391)) {
                 local_7 = is_last0_;
             } else {
                 local_7 = true;
             }
-            bool _e390 = local_7;
-            done0_ = _e390;
-            bool _e391 = done1_;
-            if (!(_e391)) {
+            bool _e396 = local_7;
+            done0_ = _e396;
+            bool _e397 = done1_;
+            if (!(_e397)) {
                 local_8 = is_last1_;
             } else {
                 local_8 = true;
             }
-            bool _e396 = local_8;
-            done1_ = _e396;
-            bool _e397 = done0_;
-            if (_e397) {
-                bool _e398 = done1_;
-                local_9 = _e398;
+            bool _e402 = local_8;
+            done1_ = _e402;
+            bool _e403 = done0_;
+            if (_e403) {
+                bool _e404 = done1_;
+                local_9 = _e404;
             } else {
                 local_9 = false;
             }
-            bool _e402 = local_9;
-            if (_e402) {
+            bool _e408 = local_9;
+            if (_e408) {
                 break;
             }
         }
     }
-    float _e408 = total0_;
-    float _e410 = total1_;
-    float l_2 = (((1.0 - w1_) * _e408) + (w1_ * _e410));
+    float _e414 = total0_;
+    float _e416 = total1_;
+    float l_2 = (((1.0 - w1_) * _e414) + (w1_ * _e416));
     float3 c_1 = (color * l_2);
     return c_1;
 }

@@ -66,6 +66,7 @@ const DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX: f32 = 0.1f;
 const MOMENT_BIAS_6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX: f32 = 0.0003f;
 const FAR_ROOTX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX: f32 = 10000f;
 const MOMENT_SPLITX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX: f32 = 0.5f;
+const STRIDE: u32 = 1u;
 const REGIONS: u32 = 4u;
 
 @group(0) @binding(0) 
@@ -569,8 +570,8 @@ fn bounds_index(x_6: u32, row: u32) -> u32 {
 
 fn filtered_index(x_7: u32, row_1: u32, layer: u32) -> u32 {
     let _e5 = frame.sizes.w;
-    let _e12 = frame.sizes.z;
-    return ((((layer * _e5) + row_1) * _e12) + x_7);
+    let _e11 = frame.sizes.z;
+    return ((((layer * _e5) + row_1) * (_e11 / STRIDE)) + x_7);
 }
 
 fn encode_layer(v_11: vec4<f32>) -> vec4<f32> {
@@ -634,125 +635,125 @@ fn scatter_pixel(x_9: u32, y_1: u32) -> vec3<f32> {
     }
     let axis = f_13.axis.xyz;
     let rows_2 = f_13.sizes.w;
-    let width_1 = f_13.sizes.z;
+    let width_1 = (f_13.sizes.z / STRIDE);
     let wrap_1 = (f_13.anti_epipole.w > 0.5f);
     {
         theta_3 = acos(clamp(dot(_e10, axis), -1f, 1f));
-        let _e59 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, _e10);
-        yc = _e59;
-        let _e61 = theta_3;
-        let _e66 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e61, f_13.theta.x, f_13.theta.y);
-        d_1 = _e66;
-        let _e68 = theta_3;
-        let _e69 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, _e10, s_5, _e68, false);
-        reach = _e69;
+        let _e61 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, _e10);
+        yc = _e61;
+        let _e63 = theta_3;
+        let _e68 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e63, f_13.theta.x, f_13.theta.y);
+        d_1 = _e68;
+        let _e70 = theta_3;
+        let _e71 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, _e10, s_5, _e70, false);
+        reach = _e71;
     }
-    let _e71 = yc;
-    let yb = (_e71 - 0.5f);
+    let _e73 = yc;
+    let yb = (_e73 - 0.5f);
     let fy = (yb - floor(yb));
-    let _e77 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(yb), rows_2, wrap_1);
-    let _e81 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX((floor(yb) + 1f), rows_2, wrap_1);
-    let row1_ = select(_e77, _e81, (yb > floor(yb)));
-    let w1_ = select(0f, fy, (row1_ != _e77));
+    let _e79 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(yb), rows_2, wrap_1);
+    let _e83 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX((floor(yb) + 1f), rows_2, wrap_1);
+    let row1_ = select(_e79, _e83, (yb > floor(yb)));
+    let w1_ = select(0f, fy, (row1_ != _e79));
     let cos_theta_l = -(dot(f_13.light_dir.xyz, _e10));
     let panels_2 = max((f_13.sizes2_.z / 4u), 1u);
-    let _e98 = d_1;
-    let _e99 = moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(_e98);
-    let _e104 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.z, cos_theta_l);
-    let sun_scatter = (f_13.medium.y * _e104);
-    let _e107 = xs;
-    xs0_ = _e107;
+    let _e100 = d_1;
+    let _e101 = moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(_e100);
+    let _e106 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.z, cos_theta_l);
+    let sun_scatter = (f_13.medium.y * _e106);
     let _e109 = xs;
-    xs1_ = _e109;
+    xs0_ = _e109;
+    let _e111 = xs;
+    xs1_ = _e111;
     {
-        let _e113 = slices[_e77];
-        let _e114 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e113);
-        delta0_ = _e114.delta;
-        let _e119 = slices[row1_];
-        let _e120 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e119);
-        delta1_ = _e120.delta;
-        let _e123 = reach;
-        let _e124 = delta0_;
-        xs0_ = (_e123 / _e124);
-        let _e126 = reach;
-        let _e127 = delta1_;
-        xs1_ = (_e126 / _e127);
+        let _e115 = slices[_e79];
+        let _e116 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e115);
+        delta0_ = (1f * _e116.delta);
+        let _e123 = slices[row1_];
+        let _e124 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e123);
+        delta1_ = (1f * _e124.delta);
+        let _e129 = reach;
+        let _e130 = delta0_;
+        xs0_ = (_e129 / _e130);
+        let _e132 = reach;
+        let _e133 = delta1_;
+        xs1_ = (_e132 / _e133);
     }
-    let _e129 = xs0_;
-    let last0_ = u32(min(max(_e129, 0f), (f32(width_1) - 1f)));
-    let _e137 = xs1_;
-    let last1_ = u32(min(max(_e137, 0f), (f32(width_1) - 1f)));
+    let _e135 = xs0_;
+    let last0_ = u32(min(max(_e135, 0f), (f32(width_1) - 1f)));
+    let _e143 = xs1_;
+    let last1_ = u32(min(max(_e143, 0f), (f32(width_1) - 1f)));
     loop {
-        let _e147 = r_1;
-        if (_e147 < REGIONS) {
+        let _e153 = r_1;
+        if (_e153 < REGIONS) {
         } else {
             break;
         }
         {
-            let _e149 = r_1;
-            let _e150 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e149, REGIONS, width_1, false);
-            let b0_ = f32(_e150);
-            let _e152 = r_1;
-            let _e155 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e152 + 1u), REGIONS, width_1, false);
-            let b1_2 = f32(_e155);
+            let _e155 = r_1;
+            let _e156 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e155, REGIONS, width_1, false);
+            let b0_ = f32(_e156);
+            let _e158 = r_1;
+            let _e161 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e158 + 1u), REGIONS, width_1, false);
+            let b1_2 = f32(_e161);
             if !((last0_ < u32(b1_2))) {
-                let _e160 = r_1;
-                local_3 = ((_e160 + 1u) == REGIONS);
+                let _e166 = r_1;
+                local_3 = ((_e166 + 1u) == REGIONS);
             } else {
                 local_3 = true;
             }
             let is_last0_ = local_3;
             if !((last1_ < u32(b1_2))) {
-                let _e171 = r_1;
-                local_4 = ((_e171 + 1u) == REGIONS);
+                let _e177 = r_1;
+                local_4 = ((_e177 + 1u) == REGIONS);
             } else {
                 local_4 = true;
             }
             let is_last1_ = local_4;
-            let _e181 = xs0_;
-            let pos0_ = select((b1_2 - 0.5f), clamp((_e181 - 0.5f), (b0_ + 0.5f), (b1_2 - 0.5f)), is_last0_);
-            let _e192 = xs1_;
-            let pos1_ = select((b1_2 - 0.5f), clamp((_e192 - 0.5f), (b0_ + 0.5f), (b1_2 - 0.5f)), is_last1_);
+            let _e187 = xs0_;
+            let pos0_ = select((b1_2 - 0.5f), clamp((_e187 - 0.5f), (b0_ + 0.5f), (b1_2 - 0.5f)), is_last0_);
+            let _e198 = xs1_;
+            let pos1_ = select((b1_2 - 0.5f), clamp((_e198 - 0.5f), (b0_ + 0.5f), (b1_2 - 0.5f)), is_last1_);
             a0_ = f32();
             e0_ = f32();
             a1_ = f32();
             e1_ = f32();
-            let _e209 = delta0_;
-            let _e210 = theta_3;
-            let _e211 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b0_, _e209, _e210, s_5, false);
-            a0_ = _e211;
-            let _e212 = delta0_;
-            let _e213 = theta_3;
-            let _e214 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b1_2, _e212, _e213, s_5, false);
-            e0_ = select(_e214, s_5, is_last0_);
-            let _e216 = delta1_;
-            let _e217 = theta_3;
-            let _e218 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b0_, _e216, _e217, s_5, false);
-            a1_ = _e218;
-            let _e219 = delta1_;
-            let _e220 = theta_3;
-            let _e221 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b1_2, _e219, _e220, s_5, false);
-            e1_ = select(_e221, s_5, is_last1_);
+            let _e215 = delta0_;
+            let _e216 = theta_3;
+            let _e217 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b0_, _e215, _e216, s_5, false);
+            a0_ = _e217;
+            let _e218 = delta0_;
+            let _e219 = theta_3;
+            let _e220 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b1_2, _e218, _e219, s_5, false);
+            e0_ = select(_e220, s_5, is_last0_);
+            let _e222 = delta1_;
+            let _e223 = theta_3;
+            let _e224 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b0_, _e222, _e223, s_5, false);
+            a1_ = _e224;
+            let _e225 = delta1_;
+            let _e226 = theta_3;
+            let _e227 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b1_2, _e225, _e226, s_5, false);
+            e1_ = select(_e227, s_5, is_last1_);
             weight0_ = f32();
             weight1_ = f32();
             if false {
-                let _e227 = a0_;
-                let _e228 = e0_;
-                let _e229 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, _e10, _e227, _e228, panels_2);
-                weight0_ = _e229;
-                let _e230 = a1_;
-                let _e231 = e1_;
-                let _e232 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, _e10, _e230, _e231, panels_2);
-                weight1_ = _e232;
+                let _e233 = a0_;
+                let _e234 = e0_;
+                let _e235 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, _e10, _e233, _e234, panels_2);
+                weight0_ = _e235;
+                let _e236 = a1_;
+                let _e237 = e1_;
+                let _e238 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, _e10, _e236, _e237, panels_2);
+                weight1_ = _e238;
             } else {
-                let _e235 = a0_;
-                let _e236 = e0_;
-                let _e237 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.x, _e235, _e236);
-                weight0_ = (sun_scatter * _e237);
-                let _e241 = a1_;
-                let _e242 = e1_;
+                let _e241 = a0_;
+                let _e242 = e0_;
                 let _e243 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.x, _e241, _e242);
-                weight1_ = (sun_scatter * _e243);
+                weight0_ = (sun_scatter * _e243);
+                let _e247 = a1_;
+                let _e248 = e1_;
+                let _e249 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.x, _e247, _e248);
+                weight1_ = (sun_scatter * _e249);
             }
             let xb0_ = (pos0_ - 0.5f);
             let fx0_ = (xb0_ - floor(xb0_));
@@ -762,106 +763,106 @@ fn scatter_pixel(x_9: u32, y_1: u32) -> vec3<f32> {
             let fx1_ = (xb1_ - floor(xb1_));
             let x10_ = u32(clamp(floor(xb1_), 0f, (f32(width_1) - 1f)));
             let x11_ = select(x10_, min((x10_ + 1u), (width_1 - 1u)), (xb1_ > floor(xb1_)));
-            let _e283 = bounds_index(x01_, _e77);
-            let lohi0_ = bounds[_e283];
-            let _e287 = bounds_index(x11_, row1_);
-            let lohi1_ = bounds[_e287];
+            let _e289 = bounds_index(x01_, _e79);
+            let lohi0_ = bounds[_e289];
+            let _e293 = bounds_index(x11_, row1_);
+            let lohi1_ = bounds[_e293];
             vis0_ = 0.5f;
             vis1_ = 0.5f;
-            let _e295 = d_1;
-            if (_e295 > lohi0_.x) {
-                let _e298 = d_1;
-                local_5 = (_e298 <= lohi0_.y);
+            let _e301 = d_1;
+            if (_e301 > lohi0_.x) {
+                let _e304 = d_1;
+                local_5 = (_e304 <= lohi0_.y);
             } else {
                 local_5 = false;
             }
-            let _e304 = local_5;
-            if _e304 {
-                let _e306 = filtered_load(x00_, _e77, 0u);
-                let _e308 = filtered_load(x01_, _e77, 0u);
-                let m0_ = mix(_e306, _e308, fx0_);
-                let _e311 = filtered_load(x00_, _e77, 1u);
-                let _e313 = filtered_load(x01_, _e77, 1u);
-                let m1_ = mix(_e311, _e313, fx0_);
-                let _e316 = lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(m0_, m1_.xy, _e99);
-                vis0_ = _e316;
+            let _e310 = local_5;
+            if _e310 {
+                let _e312 = filtered_load(x00_, _e79, 0u);
+                let _e314 = filtered_load(x01_, _e79, 0u);
+                let m0_ = mix(_e312, _e314, fx0_);
+                let _e317 = filtered_load(x00_, _e79, 1u);
+                let _e319 = filtered_load(x01_, _e79, 1u);
+                let m1_ = mix(_e317, _e319, fx0_);
+                let _e322 = lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(m0_, m1_.xy, _e101);
+                vis0_ = _e322;
             }
-            let _e317 = d_1;
-            if (_e317 > lohi1_.x) {
-                let _e320 = d_1;
-                local_6 = (_e320 <= lohi1_.y);
+            let _e323 = d_1;
+            if (_e323 > lohi1_.x) {
+                let _e326 = d_1;
+                local_6 = (_e326 <= lohi1_.y);
             } else {
                 local_6 = false;
             }
-            let _e326 = local_6;
-            if _e326 {
-                let _e328 = filtered_load(x10_, row1_, 0u);
-                let _e330 = filtered_load(x11_, row1_, 0u);
-                let m0_1 = mix(_e328, _e330, fx1_);
-                let _e333 = filtered_load(x10_, row1_, 1u);
-                let _e335 = filtered_load(x11_, row1_, 1u);
-                let m1_1 = mix(_e333, _e335, fx1_);
-                let _e338 = lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(m0_1, m1_1.xy, _e99);
-                vis1_ = _e338;
+            let _e332 = local_6;
+            if _e332 {
+                let _e334 = filtered_load(x10_, row1_, 0u);
+                let _e336 = filtered_load(x11_, row1_, 0u);
+                let m0_1 = mix(_e334, _e336, fx1_);
+                let _e339 = filtered_load(x10_, row1_, 1u);
+                let _e341 = filtered_load(x11_, row1_, 1u);
+                let m1_1 = mix(_e339, _e341, fx1_);
+                let _e344 = lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(m0_1, m1_1.xy, _e101);
+                vis1_ = _e344;
             }
-            let _e339 = vis0_;
-            let _e340 = d_1;
-            let _e345 = d_1;
-            vis0_ = select(select(_e339, 0f, (_e340 > lohi0_.y)), 1f, (_e345 <= lohi0_.x));
-            let _e350 = vis1_;
+            let _e345 = vis0_;
+            let _e346 = d_1;
             let _e351 = d_1;
-            let _e356 = d_1;
-            vis1_ = select(select(_e350, 0f, (_e351 > lohi1_.y)), 1f, (_e356 <= lohi1_.x));
-            let _e362 = done0_;
-            if !(_e362) {
-                let _e365 = total0_;
-                let _e366 = weight0_;
-                let _e367 = vis0_;
-                total0_ = (_e365 + (_e366 * clamp(_e367, 0f, 1f)));
+            vis0_ = select(select(_e345, 0f, (_e346 > lohi0_.y)), 1f, (_e351 <= lohi0_.x));
+            let _e356 = vis1_;
+            let _e357 = d_1;
+            let _e362 = d_1;
+            vis1_ = select(select(_e356, 0f, (_e357 > lohi1_.y)), 1f, (_e362 <= lohi1_.x));
+            let _e368 = done0_;
+            if !(_e368) {
+                let _e371 = total0_;
+                let _e372 = weight0_;
+                let _e373 = vis0_;
+                total0_ = (_e371 + (_e372 * clamp(_e373, 0f, 1f)));
             }
-            let _e374 = done1_;
-            if !(_e374) {
-                let _e377 = total1_;
-                let _e378 = weight1_;
-                let _e379 = vis1_;
-                total1_ = (_e377 + (_e378 * clamp(_e379, 0f, 1f)));
+            let _e380 = done1_;
+            if !(_e380) {
+                let _e383 = total1_;
+                let _e384 = weight1_;
+                let _e385 = vis1_;
+                total1_ = (_e383 + (_e384 * clamp(_e385, 0f, 1f)));
             }
-            let _e385 = done0_;
-            if !(_e385) {
+            let _e391 = done0_;
+            if !(_e391) {
                 local_7 = is_last0_;
             } else {
                 local_7 = true;
             }
-            let _e390 = local_7;
-            done0_ = _e390;
-            let _e391 = done1_;
-            if !(_e391) {
+            let _e396 = local_7;
+            done0_ = _e396;
+            let _e397 = done1_;
+            if !(_e397) {
                 local_8 = is_last1_;
             } else {
                 local_8 = true;
             }
-            let _e396 = local_8;
-            done1_ = _e396;
-            let _e397 = done0_;
-            if _e397 {
-                let _e398 = done1_;
-                local_9 = _e398;
+            let _e402 = local_8;
+            done1_ = _e402;
+            let _e403 = done0_;
+            if _e403 {
+                let _e404 = done1_;
+                local_9 = _e404;
             } else {
                 local_9 = false;
             }
-            let _e402 = local_9;
-            if _e402 {
+            let _e408 = local_9;
+            if _e408 {
                 break;
             }
         }
         continuing {
-            let _e404 = r_1;
-            r_1 = (_e404 + 1u);
+            let _e410 = r_1;
+            r_1 = (_e410 + 1u);
         }
     }
-    let _e408 = total0_;
-    let _e410 = total1_;
-    let l_2 = (((1f - w1_) * _e408) + (w1_ * _e410));
+    let _e414 = total0_;
+    let _e416 = total1_;
+    let l_2 = (((1f - w1_) * _e414) + (w1_ * _e416));
     let c_1 = (color * l_2);
     return c_1;
 }
