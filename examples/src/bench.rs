@@ -976,6 +976,21 @@ fn sampled_variants() -> Vec<(Method, Method)> {
             }
         }
     }
+    // Coarse filtered columns (`filtered_stride` 4): the prefiltered default sampled with
+    // [`SLICE_ROWS_RECTIFIED`] against the same variant per pixel and against the default
+    // per pixel (its `prefilter` is the stores of every rectified texel: docs/roofline.md,
+    // "Stop 54").
+    let stride4: FamilyVariant = PrefilteredVariant {
+        filtered_stride: 4,
+        ..PrefilteredVariant::default()
+    }
+    .into();
+    let stride4_sampled = Method::new(
+        stride4.with_sampling(SamplingKnobs::epipolar(HEADLINE_SLICES)),
+        Some(SLICE_ROWS_RECTIFIED),
+    );
+    out.push((Method::from(stride4), stride4_sampled));
+    out.push((Method::prefiltered_default(), stride4_sampled));
     for slices in [SamplingKnobs::DEFAULT_SLICES, HEADLINE_SLICES] {
         out.push((
             Method::from(n256),
@@ -1016,7 +1031,10 @@ fn headline_runs(ctx: &Context, config: &BenchConfig) -> Result<Vec<HeadlineRow>
     // The sampling stage (issue 14): each family's default, and the moment basis's
     // cheapest, at 1/2 and 1/4 of the screen per axis and epipolar.
     for (_, sampled) in sampled_variants() {
-        methods.push(sampled);
+        // A sampled method may be paired with more than one per-pixel one: run it once.
+        if !methods.contains(&sampled) {
+            methods.push(sampled);
+        }
     }
     // Epipolar sampling with a rectified map of as many rows as slices (512x512): a quarter
     // of the fixed passes' texels, which dominate the sampled prefiltered and minmax frames;
@@ -1068,6 +1086,29 @@ fn headline_runs(ctx: &Context, config: &BenchConfig) -> Result<Vec<HeadlineRow>
         methods.push(Method::new(
             r8.with_sampling(SamplingKnobs::lowres(2)),
             Some(map),
+        ));
+    }
+    // Coarse filtered columns: the default per pixel at filtered_stride 2 and 4 (sampled
+    // with stride 4 in `sampled_variants`); m32-r8 lowres 2 at stride 4 (issue 13's target
+    // at raymarch n256's error); m96 and m128 with 8 regions at lowres 2 and stride 4, whose
+    // Fourier error floor on foliage reaches minmax's (issue 13's third target: m128-r8
+    // lowres 2 0.0676 % at stride 1, `prefilter` 252 of 368 ms in the nineteenth run's
+    // state; 0.0691 % at stride 4).
+    for k in [2, 4] {
+        methods.push(Method::from(PrefilteredVariant {
+            filtered_stride: k,
+            ..PrefilteredVariant::default()
+        }));
+    }
+    for bases in [32, 96, 128] {
+        methods.push(Method::from(
+            FamilyVariant::from(PrefilteredVariant {
+                bases,
+                regions: 8,
+                filtered_stride: 4,
+                ..PrefilteredVariant::default()
+            })
+            .with_sampling(SamplingKnobs::lowres(2)),
         ));
     }
     if !families.is_empty() {

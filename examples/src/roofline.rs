@@ -427,19 +427,19 @@ pub fn kernel_costs() -> Vec<KernelCost> {
             kernel: "prefilter",
             invocations: hr * regions * threads,
             // Per texel of its region (Wr/regions on average): one load; sin(theta_ref) twice
-            // (ref_t), two exp (transmittance_between), sin and cos of pi d; a skip of
-            // 2 thread lpt turns (lpt (threads - 1) on average, 4 FMAs each) and per layer 2
-            // turns, the blend and the store scale (about 28 FMAs); stores of lpt rgba8
-            // texels, and thread 0 the rg32float bounds (8 bytes, 8 / threads per thread).
+            // (ref_t), two exp (transmittance_between), sin and cos of pi d, and threads
+            // t > 0 sin and cos of their first frequency; per layer 2 turns, the blend and
+            // the store scale (about 28 FMAs); stores of lpt rgba8 texels, and thread 0 the
+            // rg32float bounds (8 bytes, 8 / threads per thread).
             counts: [
                 region_texels * (4.0 * lpt + 8.0 / threads as f64),
                 region_texels,
                 0.0,
-                region_texels * 6.0,
-                region_texels * (4.0 * lpt * (threads - 1) as f64 + 28.0 * lpt + 10.0),
+                region_texels * (6.0 + 2.0 * (threads - 1) as f64 / threads as f64),
+                region_texels * (28.0 * lpt + 10.0),
             ],
             low: None,
-            trips: "Wr/regions texels x (2 thread lpt skip turns + lpt layers)",
+            trips: "Wr/regions texels x lpt layers",
         },
         KernelCost {
             method: "prefiltered m32-t16-r4",

@@ -3,8 +3,10 @@
 //! (`reference/src/kernels/{rectify,prefilter,scatter}.rs`, driven by
 //! `scatter_reference::kernels::run_prefiltered`) for every variant of the design card:
 //! bases {4, 8, 16, 32, 64, 128} x every valid bases_per_thread x regions {1, 2, 3, 4} x
-//! visibility x light x storage x rectification, and the moment basis (4 or 6 moments,
-//! rgba32float) x regions x visibility x light x rectification (the moments are stored raw,
+//! visibility x light x storage x rectification, the moment basis (4 or 6 moments,
+//! rgba32float) x regions x visibility x light x rectification, and coarse filtered columns
+//! (`filtered_stride` 2, 4, 8 x light x rectification x visibility x five bases, and the spot's
+//! cookie) (the moments are stored raw,
 //! within the float formats' `1e-3`; the output within `1e-3 * max radiance`, as the Fourier
 //! float variants, although the reconstruction is a solve). Directional variants run on
 //! `columns/ordinary`, spot variants on `spot_grate/ordinary`, 64x36 pixels, a 128^2 shadow
@@ -28,7 +30,7 @@
 //!   `max |diff| / max radiance` without that allowance.
 //!
 //! Each variant is one libtest trial (`cargo test -p scatter-conformance --test prefiltered
-//! -- m32-t16-r4` runs those whose name contains the filter, `-- --list` lists the 2080);
+//! -- m32-t16-r4` runs those whose name contains the filter, `-- --list` lists the 2230);
 //! `prefiltered::errors::*` check the error paths.
 
 use std::process::ExitCode;

@@ -191,7 +191,7 @@ fn spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye: vec3<f32>, dir: v
 
 fn spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1: vec3<f32>, dir_1: vec3<f32>, a_1: f32, b_1: f32, panels: u32, light_pos_1: vec3<f32>, light_dir_1: vec3<f32>, cos_inner_2: f32, cos_outer_2: f32, medium_1: vec4<f32>) -> f32 {
     var sum: f32 = 0f;
-    var k_1: u32 = 0u;
+    var k: u32 = 0u;
     var q_1: u32;
 
     let t0_ = dot((light_pos_1 - eye_1), dir_1);
@@ -199,13 +199,13 @@ fn spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1: vec3<f32>, dir_1: ve
     let g0_ = atan(((a_1 - t0_) / h));
     let w_2 = ((atan(((b_1 - t0_) / h)) - g0_) / f32(panels));
     loop {
-        let _e30 = k_1;
+        let _e30 = k;
         if ((_e30 + 1u) <= panels) {
         } else {
             break;
         }
         {
-            let _e34 = k_1;
+            let _e34 = k;
             let mid = (g0_ + ((f32(_e34) + 0.5f) * w_2));
             q_1 = 0u;
             loop {
@@ -229,8 +229,8 @@ fn spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1: vec3<f32>, dir_1: ve
             }
         }
         continuing {
-            let _e75 = k_1;
-            k_1 = (_e75 + 1u);
+            let _e75 = k;
+            k = (_e75 + 1u);
         }
     }
     let _e77 = sum;
@@ -404,7 +404,6 @@ fn prefilter(@builtin(global_invocation_id) id: vec3<u32>) {
     var hi: f32 = -1000000000000000000000000000000f;
     var i: u32;
     var angle: vec2<f32>;
-    var k: u32;
     var q: u32;
 
     let row_6 = id.x;
@@ -473,61 +472,48 @@ fn prefilter(@builtin(global_invocation_id) id: vec3<u32>) {
             angle = vec2<f32>(sin((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * d_1)), cos((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * d_1)));
             let _e103 = angle;
             let _e104 = fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e103);
-            k = 0u;
-            loop {
-                let _e107 = k;
-                if (_e107 < ((2u * thread) * 1u)) {
-                } else {
-                    break;
-                }
-                {
-                    let _e113 = angle;
-                    let _e114 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e113, _e104);
-                    angle = _e114;
-                }
-                continuing {
-                    let _e116 = k;
-                    k = (_e116 + 1u);
-                }
+            if (thread > 0u) {
+                let c = ((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * d_1) * f32((1u + ((4u * thread) * 1u))));
+                angle = vec2<f32>(sin(c), cos(c));
             }
             q = 0u;
             loop {
-                let _e120 = q;
-                if (_e120 < 1u) {
+                let _e122 = q;
+                if (_e122 < 1u) {
                 } else {
                     break;
                 }
                 {
-                    let _e123 = q;
-                    let layer_2 = ((thread * 1u) + _e123);
-                    let _e125 = angle;
-                    let _e126 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e125, _e104);
+                    let _e125 = q;
+                    let layer_2 = ((thread * 1u) + _e125);
                     let _e127 = angle;
-                    let _e128 = basis4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e127, _e126);
-                    let _e129 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e126, _e104);
-                    angle = _e129;
-                    let _e131 = q;
-                    let a_6 = acc[_e131];
-                    let _e134 = q;
-                    acc[_e134] = ((a_6 * (1f - blend)) + (_e128 * blend));
-                    let _e141 = q;
-                    let _e143 = acc[_e141];
-                    let stored = ((_e143 * 0.5f) + vec4(0.5f));
+                    let _e128 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e127, _e104);
+                    let _e129 = angle;
+                    let _e130 = basis4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e129, _e128);
+                    let _e131 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e128, _e104);
+                    angle = _e131;
+                    let _e133 = q;
+                    let a_6 = acc[_e133];
+                    let _e136 = q;
+                    acc[_e136] = ((a_6 * (1f - blend)) + (_e130 * blend));
+                    let _e143 = q;
+                    let _e145 = acc[_e143];
+                    let stored = ((_e145 * 0.5f) + vec4(0.5f));
                     if store {
-                        let _e149 = filtered_index(x_9, row_6, layer_2);
-                        let _e152 = encode_layer(stored);
-                        filtered[_e149] = _e152;
+                        let _e151 = filtered_index(x_9, row_6, layer_2);
+                        let _e154 = encode_layer(stored);
+                        filtered[_e151] = _e154;
                     }
                 }
                 continuing {
-                    let _e154 = q;
-                    q = (_e154 + 1u);
+                    let _e156 = q;
+                    q = (_e156 + 1u);
                 }
             }
         }
         continuing {
-            let _e157 = i;
-            i = (_e157 + 1u);
+            let _e159 = i;
+            i = (_e159 + 1u);
         }
     }
     return;

@@ -193,7 +193,7 @@ float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye, vec3 dir,
 
 float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye_1, vec3 dir_1, float a_1, float b_1, uint panels, vec3 light_pos_1, vec3 light_dir_1, float cos_inner_2, float cos_outer_2, vec4 medium_1) {
     float sum = 0.0;
-    uint k_1 = 0u;
+    uint k = 0u;
     uint q_1 = 0u;
     float t0_ = dot((light_pos_1 - eye_1), dir_1);
     float h = max(length(((eye_1 + (dir_1 * t0_)) - light_pos_1)), (0.0001 * max((b_1 - a_1), 1e-6)));
@@ -202,17 +202,17 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye_1, vec3 dir_1, 
     bool loop_init = true;
     while(true) {
         if (!loop_init) {
-            uint _e75 = k_1;
-            k_1 = (_e75 + 1u);
+            uint _e75 = k;
+            k = (_e75 + 1u);
         }
         loop_init = false;
-        uint _e30 = k_1;
+        uint _e30 = k;
         if (((_e30 + 1u) <= panels)) {
         } else {
             break;
         }
         {
-            uint _e34 = k_1;
+            uint _e34 = k;
             float mid = (g0_ + ((float(_e34) + 0.5) * w_2));
             q_1 = 0u;
             bool loop_init_1 = true;
@@ -400,7 +400,6 @@ void main() {
     float hi = -1e30;
     uint i = 0u;
     vec2 angle = vec2(0.0);
-    uint k = 0u;
     uint q = 0u;
     uint row_6 = id.x;
     uint region = id.y;
@@ -434,8 +433,8 @@ void main() {
     bool loop_init_2 = true;
     while(true) {
         if (!loop_init_2) {
-            uint _e157 = i;
-            i = (_e157 + 1u);
+            uint _e159 = i;
+            i = (_e159 + 1u);
         }
         loop_init_2 = false;
         uint _e50 = i;
@@ -475,58 +474,43 @@ void main() {
             angle = vec2(sin((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * d_1)), cos((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * d_1)));
             vec2 _e103 = angle;
             vec2 _e104 = fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e103);
-            k = 0u;
+            if ((thread > 0u)) {
+                float c = ((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * d_1) * float((1u + ((4u * thread) * 4u))));
+                angle = vec2(sin(c), cos(c));
+            }
+            q = 0u;
             bool loop_init_3 = true;
             while(true) {
                 if (!loop_init_3) {
-                    uint _e116 = k;
-                    k = (_e116 + 1u);
+                    uint _e156 = q;
+                    q = (_e156 + 1u);
                 }
                 loop_init_3 = false;
-                uint _e107 = k;
-                if ((_e107 < ((2u * thread) * 4u))) {
+                uint _e122 = q;
+                if ((_e122 < 4u)) {
                 } else {
                     break;
                 }
                 {
-                    vec2 _e113 = angle;
-                    vec2 _e114 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e113, _e104);
-                    angle = _e114;
-                }
-            }
-            q = 0u;
-            bool loop_init_4 = true;
-            while(true) {
-                if (!loop_init_4) {
-                    uint _e154 = q;
-                    q = (_e154 + 1u);
-                }
-                loop_init_4 = false;
-                uint _e120 = q;
-                if ((_e120 < 4u)) {
-                } else {
-                    break;
-                }
-                {
-                    uint _e123 = q;
-                    uint layer_2 = ((thread * 4u) + _e123);
-                    vec2 _e125 = angle;
-                    vec2 _e126 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e125, _e104);
+                    uint _e125 = q;
+                    uint layer_2 = ((thread * 4u) + _e125);
                     vec2 _e127 = angle;
-                    vec4 _e128 = basis4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e127, _e126);
-                    vec2 _e129 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e126, _e104);
-                    angle = _e129;
-                    uint _e131 = q;
-                    vec4 a_6 = acc[_e131];
-                    uint _e134 = q;
-                    acc[_e134] = ((a_6 * (1.0 - blend)) + (_e128 * blend));
-                    uint _e141 = q;
-                    vec4 _e143 = acc[_e141];
-                    vec4 stored = ((_e143 * 0.5) + vec4(0.5));
+                    vec2 _e128 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e127, _e104);
+                    vec2 _e129 = angle;
+                    vec4 _e130 = basis4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e129, _e128);
+                    vec2 _e131 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e128, _e104);
+                    angle = _e131;
+                    uint _e133 = q;
+                    vec4 a_6 = acc[_e133];
+                    uint _e136 = q;
+                    acc[_e136] = ((a_6 * (1.0 - blend)) + (_e130 * blend));
+                    uint _e143 = q;
+                    vec4 _e145 = acc[_e143];
+                    vec4 stored = ((_e145 * 0.5) + vec4(0.5));
                     if (store) {
-                        uint _e149 = filtered_index(x_9, row_6, layer_2);
-                        uint _e152 = encode_layer(stored);
-                        _group_0_binding_3_cs[_e149] = _e152;
+                        uint _e151 = filtered_index(x_9, row_6, layer_2);
+                        uint _e154 = encode_layer(stored);
+                        _group_0_binding_3_cs[_e151] = _e154;
                     }
                 }
             }

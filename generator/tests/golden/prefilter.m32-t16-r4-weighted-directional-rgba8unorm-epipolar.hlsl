@@ -205,7 +205,7 @@ float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye, float3 
 float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye_1, float3 dir_1, float a_1, float b_1, uint panels, float3 light_pos_1, float3 light_dir_1, float cos_inner_2, float cos_outer_2, float4 medium_1)
 {
     float sum = 0.0;
-    uint k_1 = 0u;
+    uint k = 0u;
     uint q_1 = (uint)0;
 
     float t0_ = dot((light_pos_1 - eye_1), dir_1);
@@ -218,17 +218,17 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye_1, float3 dir
         if (all(loop_bound == uint2(0u, 0u))) { break; }
         loop_bound -= uint2(loop_bound.y == 0u, 1u);
         if (!loop_init) {
-            uint _e75 = k_1;
-            k_1 = (_e75 + 1u);
+            uint _e75 = k;
+            k = (_e75 + 1u);
         }
         loop_init = false;
-        uint _e30 = k_1;
+        uint _e30 = k;
         if (((_e30 + 1u) <= panels)) {
         } else {
             break;
         }
         {
-            uint _e34 = k_1;
+            uint _e34 = k;
             float mid = (g0_ + ((float(_e34) + 0.5) * w_2));
             q_1 = 0u;
             uint2 loop_bound_1 = uint2(4294967295u, 4294967295u);
@@ -479,7 +479,6 @@ void prefilter(uint3 id : SV_DispatchThreadID)
     float hi = -1e30;
     uint i = (uint)0;
     float2 angle = (float2)0;
-    uint k = (uint)0;
     uint q = (uint)0;
 
     uint row_6 = id.x;
@@ -517,8 +516,8 @@ void prefilter(uint3 id : SV_DispatchThreadID)
         if (all(loop_bound_2 == uint2(0u, 0u))) { break; }
         loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
         if (!loop_init_2) {
-            uint _e157 = i;
-            i = (_e157 + 1u);
+            uint _e159 = i;
+            i = (_e159 + 1u);
         }
         loop_init_2 = false;
         uint _e50 = i;
@@ -557,64 +556,46 @@ void prefilter(uint3 id : SV_DispatchThreadID)
             angle = float2(sin((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * d_1)), cos((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * d_1)));
             float2 _e103 = angle;
             const float2 _e104 = fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e103);
-            k = 0u;
+            if ((thread > 0u)) {
+                float c = ((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * d_1) * float((1u + ((4u * thread) * 4u))));
+                angle = float2(sin(c), cos(c));
+            }
+            q = 0u;
             uint2 loop_bound_3 = uint2(4294967295u, 4294967295u);
             bool loop_init_3 = true;
             while(true) {
                 if (all(loop_bound_3 == uint2(0u, 0u))) { break; }
                 loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
                 if (!loop_init_3) {
-                    uint _e116 = k;
-                    k = (_e116 + 1u);
+                    uint _e156 = q;
+                    q = (_e156 + 1u);
                 }
                 loop_init_3 = false;
-                uint _e107 = k;
-                if ((_e107 < ((2u * thread) * 4u))) {
+                uint _e122 = q;
+                if ((_e122 < 4u)) {
                 } else {
                     break;
                 }
                 {
-                    float2 _e113 = angle;
-                    const float2 _e114 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e113, _e104);
-                    angle = _e114;
-                }
-            }
-            q = 0u;
-            uint2 loop_bound_4 = uint2(4294967295u, 4294967295u);
-            bool loop_init_4 = true;
-            while(true) {
-                if (all(loop_bound_4 == uint2(0u, 0u))) { break; }
-                loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
-                if (!loop_init_4) {
-                    uint _e154 = q;
-                    q = (_e154 + 1u);
-                }
-                loop_init_4 = false;
-                uint _e120 = q;
-                if ((_e120 < 4u)) {
-                } else {
-                    break;
-                }
-                {
-                    uint _e123 = q;
-                    uint layer_2 = ((thread * 4u) + _e123);
-                    float2 _e125 = angle;
-                    const float2 _e126 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e125, _e104);
+                    uint _e125 = q;
+                    uint layer_2 = ((thread * 4u) + _e125);
                     float2 _e127 = angle;
-                    const float4 _e128 = basis4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e127, _e126);
-                    const float2 _e129 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e126, _e104);
-                    angle = _e129;
-                    uint _e131 = q;
-                    float4 a_6 = acc[min(uint(_e131), 3u)];
-                    uint _e134 = q;
-                    acc[min(uint(_e134), 3u)] = ((a_6 * (1.0 - blend)) + (_e128 * blend));
-                    uint _e141 = q;
-                    float4 _e143 = acc[min(uint(_e141), 3u)];
-                    float4 stored = ((_e143 * 0.5) + (0.5).xxxx);
+                    const float2 _e128 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e127, _e104);
+                    float2 _e129 = angle;
+                    const float4 _e130 = basis4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e129, _e128);
+                    const float2 _e131 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e128, _e104);
+                    angle = _e131;
+                    uint _e133 = q;
+                    float4 a_6 = acc[min(uint(_e133), 3u)];
+                    uint _e136 = q;
+                    acc[min(uint(_e136), 3u)] = ((a_6 * (1.0 - blend)) + (_e130 * blend));
+                    uint _e143 = q;
+                    float4 _e145 = acc[min(uint(_e143), 3u)];
+                    float4 stored = ((_e145 * 0.5) + (0.5).xxxx);
                     if (store) {
-                        const uint _e149 = filtered_index(x_9, row_6, layer_2);
-                        const uint _e152 = encode_layer(stored);
-                        filtered.Store(_e149*4, asuint(_e152));
+                        const uint _e151 = filtered_index(x_9, row_6, layer_2);
+                        const uint _e154 = encode_layer(stored);
+                        filtered.Store(_e151*4, asuint(_e154));
                     }
                 }
             }

@@ -264,7 +264,7 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     metal::float4 medium_1
 ) {
     float sum = 0.0;
-    uint k_1 = 0u;
+    uint k = 0u;
     uint q_1 = {};
     float t0_ = metal::dot(light_pos_1 - eye_1, dir_1);
     float h = metal::max(metal::length((eye_1 + (dir_1 * t0_)) - light_pos_1), 0.0001 * metal::max(b_1 - a_1, 0.000001));
@@ -276,17 +276,17 @@ float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
         if (metal::all(loop_bound == uint2(0u))) { break; }
         loop_bound -= uint2(loop_bound.y == 0u, 1u);
         if (!loop_init) {
-            uint _e75 = k_1;
-            k_1 = _e75 + 1u;
+            uint _e75 = k;
+            k = _e75 + 1u;
         }
         loop_init = false;
-        uint _e30 = k_1;
+        uint _e30 = k;
         if ((_e30 + 1u) <= panels) {
         } else {
             break;
         }
         {
-            uint _e34 = k_1;
+            uint _e34 = k;
             float mid = g0_ + ((static_cast<float>(_e34) + 0.5) * w_2);
             q_1 = 0u;
             uint2 loop_bound_1 = uint2(4294967295u);
@@ -585,7 +585,6 @@ kernel void prefilter(
     float hi = -1000000000000000000000000000000.0;
     uint i = {};
     metal::float2 angle = {};
-    uint k = {};
     uint q = {};
     uint row_6 = id.x;
     uint region = id.y;
@@ -622,8 +621,8 @@ kernel void prefilter(
         if (metal::all(loop_bound_2 == uint2(0u))) { break; }
         loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
         if (!loop_init_2) {
-            uint _e157 = i;
-            i = _e157 + 1u;
+            uint _e159 = i;
+            i = _e159 + 1u;
         }
         loop_init_2 = false;
         uint _e50 = i;
@@ -663,64 +662,46 @@ kernel void prefilter(
             angle = metal::float2(metal::sin(PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * d_1), metal::cos(PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * d_1));
             metal::float2 _e103 = angle;
             metal::float2 _e104 = fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e103);
-            k = 0u;
+            if (thread_ > 0u) {
+                float c = (PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * d_1) * static_cast<float>(1u + ((4u * thread_) * 4u));
+                angle = metal::float2(metal::sin(c), metal::cos(c));
+            }
+            q = 0u;
             uint2 loop_bound_3 = uint2(4294967295u);
             bool loop_init_3 = true;
             while(true) {
                 if (metal::all(loop_bound_3 == uint2(0u))) { break; }
                 loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
                 if (!loop_init_3) {
-                    uint _e116 = k;
-                    k = _e116 + 1u;
+                    uint _e156 = q;
+                    q = _e156 + 1u;
                 }
                 loop_init_3 = false;
-                uint _e107 = k;
-                if (_e107 < ((2u * thread_) * 4u)) {
+                uint _e122 = q;
+                if (_e122 < 4u) {
                 } else {
                     break;
                 }
                 {
-                    metal::float2 _e113 = angle;
-                    metal::float2 _e114 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e113, _e104);
-                    angle = _e114;
-                }
-            }
-            q = 0u;
-            uint2 loop_bound_4 = uint2(4294967295u);
-            bool loop_init_4 = true;
-            while(true) {
-                if (metal::all(loop_bound_4 == uint2(0u))) { break; }
-                loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
-                if (!loop_init_4) {
-                    uint _e154 = q;
-                    q = _e154 + 1u;
-                }
-                loop_init_4 = false;
-                uint _e120 = q;
-                if (_e120 < 4u) {
-                } else {
-                    break;
-                }
-                {
-                    uint _e123 = q;
-                    uint layer_2 = (thread_ * 4u) + _e123;
-                    metal::float2 _e125 = angle;
-                    metal::float2 _e126 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e125, _e104);
+                    uint _e125 = q;
+                    uint layer_2 = (thread_ * 4u) + _e125;
                     metal::float2 _e127 = angle;
-                    metal::float4 _e128 = basis4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e127, _e126);
-                    metal::float2 _e129 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e126, _e104);
-                    angle = _e129;
-                    uint _e131 = q;
-                    metal::float4 a_6 = acc.inner[metal::min(unsigned(_e131), 3u)];
-                    uint _e134 = q;
-                    acc.inner[metal::min(unsigned(_e134), 3u)] = (a_6 * (1.0 - blend)) + (_e128 * blend);
-                    uint _e141 = q;
-                    metal::float4 _e143 = acc.inner[metal::min(unsigned(_e141), 3u)];
-                    metal::float4 stored = (_e143 * 0.5) + metal::float4(0.5);
+                    metal::float2 _e128 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e127, _e104);
+                    metal::float2 _e129 = angle;
+                    metal::float4 _e130 = basis4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e129, _e128);
+                    metal::float2 _e131 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e128, _e104);
+                    angle = _e131;
+                    uint _e133 = q;
+                    metal::float4 a_6 = acc.inner[metal::min(unsigned(_e133), 3u)];
+                    uint _e136 = q;
+                    acc.inner[metal::min(unsigned(_e136), 3u)] = (a_6 * (1.0 - blend)) + (_e130 * blend);
+                    uint _e143 = q;
+                    metal::float4 _e145 = acc.inner[metal::min(unsigned(_e143), 3u)];
+                    metal::float4 stored = (_e145 * 0.5) + metal::float4(0.5);
                     if (store) {
-                        uint _e149 = filtered_index(x_9, row_6, layer_2, frame);
-                        uint _e152 = encode_layer(stored);
-                        filtered[metal::min(unsigned(_e149), (_buffer_sizes.size3 - 0 - 4) / 4)] = _e152;
+                        uint _e151 = filtered_index(x_9, row_6, layer_2, frame);
+                        uint _e154 = encode_layer(stored);
+                        filtered[metal::min(unsigned(_e151), (_buffer_sizes.size3 - 0 - 4) / 4)] = _e154;
                     }
                 }
             }

@@ -191,11 +191,13 @@ pub fn prefilter_main(
             }
             continue;
         }
-        // The basis angles by angle addition (see the WGSL).
+        // The basis angles by angle addition; thread t > 0 starts at its first frequency
+        // directly (see the WGSL).
         let mut angle = [(PI * d).sin(), (PI * d).cos()];
         let step = fourier_step(angle);
-        for _ in 0..2 * thread * layers_per_thread {
-            angle = turn(angle, step);
+        if thread > 0 {
+            let c = PI * d * (1 + 4 * thread * layers_per_thread) as f32;
+            angle = [c.sin(), c.cos()];
         }
         for q in 0..layers_per_thread {
             let layer = thread * layers_per_thread + q;
