@@ -2197,6 +2197,13 @@ pub fn tune_candidates() -> Vec<Method> {
             }
         }
     }
+    // Coarse filtered columns: the default storing every 2nd and 4th column's means.
+    for filtered_stride in [2, 4] {
+        out.push(Method::from(PrefilteredVariant {
+            filtered_stride,
+            ..PrefilteredVariant::default()
+        }));
+    }
     for (samples, interleave) in [
         (16, 1),
         (32, 1),

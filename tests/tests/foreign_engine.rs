@@ -62,8 +62,10 @@ const REL_TOL: f32 = 1e-4;
 /// SPIR-V fallback in about one frame of four on lavapipe; CI caught it in one run).
 const FRAMES: usize = 3;
 
-/// The five trial variants (the last with the spot's cookie).
-fn variants() -> [PrefilteredVariant; 5] {
+/// The six trial variants (the fifth with the spot's cookie, the last with coarse filtered
+/// columns in a projective frame: its buffers sized by `ceil(rectified.width / 4)`, its
+/// region viewports on multiples of 4).
+fn variants() -> [PrefilteredVariant; 6] {
     [
         PrefilteredVariant::default(),
         PrefilteredVariant {
@@ -85,6 +87,11 @@ fn variants() -> [PrefilteredVariant; 5] {
         PrefilteredVariant {
             light: LightKind::Spot,
             cookie: true,
+            ..PrefilteredVariant::default()
+        },
+        PrefilteredVariant {
+            rectification: Rectification::Projective,
+            filtered_stride: 4,
             ..PrefilteredVariant::default()
         },
     ]
