@@ -183,7 +183,7 @@ pub enum FrameError {
     },
     /// A rectified width that the variant's `filtered_stride` does not divide.
     #[error(
-        "rectified width must be a multiple of filtered_stride = {stride} (prefilter stores every {stride}-th column), got {width}"
+        "rectified width must be a multiple of filtered_stride = {stride} (prefilter stores one column in {stride}), got {width}"
     )]
     RectifiedStride {
         /// The rectified width.

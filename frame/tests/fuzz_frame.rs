@@ -622,6 +622,13 @@ fn case(family_of: impl Strategy<Value = FamilyVariant>) -> impl Strategy<Value 
         prop::collection::vec(mutation(), 0..=3),
     )
         .prop_map(|(family, (w, h), (wr, hr), sm, cam, aim, fov, mutations)| {
+            // A valid base frame: a rectified width the variant's filtered stride divides
+            // (the grid's coarse-column variants have stride x regions^2 <= 64).
+            let stride = match family {
+                FamilyVariant::Prefiltered(v) => v.filtered_stride.max(1),
+                _ => 1,
+            };
+            let wr = wr - wr % stride;
             let mut c = base_case(family, [w, h], [wr, hr], sm, cam, aim, fov, mutations);
             c.apply();
             c

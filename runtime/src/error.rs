@@ -118,7 +118,7 @@ pub enum RuntimeError {
     /// A rectified width that the variant's `filtered_stride` does not divide.
     #[error(
         "kernel `{kernel}`: the rectified width must be a multiple of filtered_stride = \
-         {stride} (prefilter stores every {stride}-th column), got {width}"
+         {stride} (prefilter stores one column in {stride}), got {width}"
     )]
     StrideMismatch {
         /// The kernel.
