@@ -1016,11 +1016,14 @@ fn headline_runs(ctx: &Context, config: &BenchConfig) -> Result<Vec<HeadlineRow>
     for moments in PrefilteredVariant::MOMENTS {
         methods.push(Method::from(PrefilteredVariant::with_moments(moments)));
     }
-    // The moment basis's most accurate configuration (prefiltered_truth, random poses).
-    methods.push(Method::from(PrefilteredVariant {
-        regions: 8,
-        ..PrefilteredVariant::with_moments(6)
-    }));
+    // The moment basis with 8 regions (the random poses' row), and its most accurate
+    // configuration, 16 regions (prefiltered_truth: the bars on every pose at 1024x1024).
+    for regions in [8, 16] {
+        methods.push(Method::from(PrefilteredVariant {
+            regions,
+            ..PrefilteredVariant::with_moments(6)
+        }));
+    }
     for (samples, interleave) in [(64, 1), (128, 1), (256, 1), (64, 4)] {
         methods.push(Method::from(RaymarchVariant {
             samples,
@@ -1388,6 +1391,7 @@ pub fn ratios(result: &BenchResult) -> Vec<String> {
             ("prefiltered", "moments4-r4"),
             ("prefiltered", "moments6-r4"),
             ("prefiltered", "moments6-r8"),
+            ("prefiltered", "moments6-r16"),
             ("raymarch", "n64-i1"),
             ("raymarch", "n128-i1"),
             ("raymarch", "n256-i1"),
@@ -1435,6 +1439,7 @@ pub fn ratios(result: &BenchResult) -> Vec<String> {
         "moments4-r4",
         "moments6-r4",
         "moments6-r8",
+        "moments6-r16",
     ] {
         let Some((pt, pe)) = headline_mean("prefiltered", prefiltered) else {
             continue;

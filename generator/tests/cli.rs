@@ -50,8 +50,13 @@ fn bad_knobs_exit_2_with_one_line_and_write_nothing() {
             &["--bases", "16", "--bases-per-thread", "12"],
             "bases_per_thread must be a multiple of 4 that divides bases = 16, got 12",
         ),
-        (&["--regions", "9"], "regions must be in 1..=8, got 9"),
-        (&["--regions", "0"], "regions must be in 1..=8, got 0"),
+        (&["--regions", "17"], "regions must be in 1..=16, got 17"),
+        (&["--regions", "0"], "regions must be in 1..=16, got 0"),
+        (
+            &["--regions", "9", "--rectification", "projective"],
+            "regions must be in 1..=8 with rectification = projective (its frame holds 9 \
+             region boundaries; up to 16 with epipolar), got 9",
+        ),
         (
             &["--visibility", "median"],
             "visibility must be average | weighted, got median",
@@ -324,12 +329,12 @@ fn config_emits_exactly_its_variants() {
     // Bad config: exit 2, one line naming the file, the table and the knob.
     fs::write(
         &config,
-        "[[variant]]\nlight = \"spot\"\n[[variant]]\nregions = 12\n",
+        "[[variant]]\nlight = \"spot\"\n[[variant]]\nregions = 20\n",
     )
     .unwrap_or_else(|e| panic!("{e}"));
     let line = fails(&["--config", c, "--out", o], 2);
     assert!(
-        line.contains("variants.toml: variant 2: regions must be in 1..=8, got 12"),
+        line.contains("variants.toml: variant 2: regions must be in 1..=16, got 20"),
         "{line}"
     );
     // Slips refused with one line naming the file and the table or knob: the same variant

@@ -303,7 +303,7 @@ fn validate_on_arbitrary_numbers() {
                 Ok(()) => {
                     prop_assert!((4..=128).contains(&bases) && bases % 4 == 0);
                     prop_assert!(bpt % 4 == 0 && bases % bpt == 0);
-                    prop_assert!((1..=8).contains(&regions));
+                    prop_assert!((1..=16).contains(&regions));
                     prop_assert!(v.layers() <= 32 && v.threads_per_row_region() >= 1);
                 }
                 Err(e) => {
@@ -560,7 +560,7 @@ fn bad_value(family: Family, name: &str, pick: usize) -> String {
         "moments" => &["5", "0", "8", "\"six\""],
         "bases" => &["30", "132", "0", "-4", "\"abc\"", "4294967296", "\"\""],
         "bases_per_thread" => &["3", "0", "12", "256", "\"x\""],
-        "regions" => &["0", "9", "-1", "\"three\"", "1.5"],
+        "regions" => &["0", "17", "-1", "\"three\"", "1.5"],
         "visibility" => &["\"median\"", "\"Average\"", "\"\"", "3"],
         "light" => &["\"area\"", "\" spot\"", "\"spot\\n\"", "1"],
         "storage" => &["\"rgba8\"", "\"r32float\""],

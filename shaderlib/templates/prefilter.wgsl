@@ -4,7 +4,8 @@
 // rectified row (Klehm et al. 2014, Sec. 3.3 and 5, Listings 1-3, Table 1's regions).
 //
 // One invocation per (row, region) (thread is always 0): it filters the {{ moment_count }} power moments
-// of z = 2 d - 1, (z, z^2, z^3, z^4){% if layers > 1 %} and (z^5, z^6, 0, 0){% endif %}, in {{ layers }} layer{% if layers > 1 %}s{% endif %}.
+// of z = (2 d - lo - hi) / max(hi - lo, 0.1), (z, z^2, z^3, z^4){% if layers > 1 %} and (z^5, z^6, 0, 0){% endif %}, in {{ layers }} layer{% if layers > 1 %}s{% endif %},
+// [lo, hi] the region's whole depth range (a first pass over its depths; `moment_z`).
 // Each region restarts the running mean. Stored per texel: the normalised weighted mean
 // b_k = sum w_i z_i^k / sum w_i over the region up to the texel, as it is ({{ storage }}).
 // The invocation also stores the least and the greatest depth over the region up to the
@@ -166,6 +167,20 @@ fn prefilter(@builtin(global_invocation_id) id: vec3<u32>) {
     var wsum = 0.0;
     var lo = 1e30;
     var hi = -1e30;
+{%- if moments %}
+    // The region's whole depth range (what `bounds` holds at its last stored column), which
+    // `moment_z` maps to [-1, 1]: one pass of depth loads before the moments.
+    var depth_range = vec2<f32>(1e30, -1e30);
+    for (var i = start; i < end; i++) {
+        var d = textureLoad(rectified, vec2<u32>(i, row), 0).x;
+{%- if projective %}
+        if proj {
+            d = proj_stored_depth(d);
+        }
+{%- endif %}
+        depth_range = vec2<f32>(min(depth_range.x, d), max(depth_range.y, d));
+    }
+{%- endif %}
     for (var i = start; i < end; i++) {
 {%- if projective %}
         var d = textureLoad(rectified, vec2<u32>(i, row), 0).x;
@@ -202,8 +217,8 @@ fn prefilter(@builtin(global_invocation_id) id: vec3<u32>) {
         }
 {%- endif %}
 {%- if moments %}
-        // The power moments of z, stored as they are.
-        let z = moment_z(d);
+        // The power moments of z in the region's range, stored as they are.
+        let z = moment_z(d, depth_range);
         for (var q = 0u; q < layers_per_thread; q++) {
 {%- if cookie %}
             let b = moment_layer(z, q);

@@ -16,7 +16,7 @@
 // Weighted visibility: L = sum_j U_j Vbar_j over the regions the ray crosses, U_j the
 // pixel's own unshadowed integral over its part of the ray inside region j (closed form
 // for the sun, Gauss-Legendre for a spot) and Vbar_j the region's prefiltered visibility
-// ({% if moments %}from its moments at z = 2 d - 1{% else %}clamp(0.5 + a(d) . F_j, 0, 1){% endif %}). Average visibility combines the regions the same way; it
+// ({% if moments %}from its moments at the ray's depth in the region's moment coordinate, `moment_z`{% else %}clamp(0.5 + a(d) . F_j, 0, 1){% endif %}). Average visibility combines the regions the same way; it
 // differs in the prefilter, which weights texels by their length along the reference ray
 // instead of its transmittance (with one region: the paper's L_unshadowed * Vbar). Weighting
 // the regions by length instead (L_unshadowed * sum_j len_j Vbar_j / s) was 51 % off on
@@ -188,7 +188,9 @@ fn scatter_pixel(x: u32, y: u32) -> vec3<f32> {
 {%- else %}
     {
 {%- endif %}
-        theta = acos(clamp(dot(dir, axis), -1.0, 1.0));
+        // The view angle from the light axis as atan2(|dir x axis|, dir . axis): acos of the
+        // dot product resolves angles near the axis only to sqrt(2 * 6e-8) = 3.5e-4 in f32.
+        theta = atan2(length(cross(dir, axis)), dot(dir, axis));
         yc = ray_row_coord(f, dir);
         d = normalised_depth(theta, f.theta[0], f.theta[1]);
         reach = ray_column(f, eye, dir, s, theta, spot);
@@ -212,8 +214,8 @@ fn scatter_pixel(x: u32, y: u32) -> vec3<f32> {
     // grazing spot, spot_grate/grazing/thick).
     let panels = max(f.sizes2_[2] / 4u, 1u);
 {%- if moments %}
-    // The ray's depth in the moments' coordinate.
-    let zf = moment_z(d);
+    // (The ray's depth in the moments' coordinate depends on the region's depth range: per
+    // region and row below.)
 {%- else %}
     // The ray's Fourier coefficients depend on its depth only: once per pixel, not per
     // region, their angles c_k d by angle addition from pi d (two transcendentals per pixel).
@@ -332,24 +334,28 @@ fn scatter_pixel(x: u32, y: u32) -> vec3<f32> {
         var vis0 = 0.5 * cbar0;
         var vis1 = 0.5 * cbar1;
 {%- if moments %}
+        // The ray's depth in each row's moment coordinate: the region's whole depth range is
+        // its bounds at its last stored column (`moment_z`).
+        let zf0 = moment_z(d, bounds[bounds_index(u32(b1) - 1u, row0)]);
+        let zf1 = moment_z(d, bounds[bounds_index(u32(b1) - 1u, row1)]);
         // Per channel the moments of the cookie-weighted depths: the stored ones over Cbar.
         for (var c = 0u; c < 3u; c++) {
             if d > lohi0.x && d <= lohi0.y && cbar0[c] > 0.0 {
                 let m0 = mix(filtered_load(x00, row0, c * LAYERS), filtered_load(x01, row0, c * LAYERS), fx0) / cbar0[c];
 {%- if moment_count == 6 %}
                 let m1 = mix(filtered_load(x00, row0, c * LAYERS + 1u), filtered_load(x01, row0, c * LAYERS + 1u), fx0) / cbar0[c];
-                vis0[c] = cbar0[c] * lit_moments6(m0, m1.xy, zf);
+                vis0[c] = cbar0[c] * lit_moments6(m0, m1.xy, zf0);
 {%- else %}
-                vis0[c] = cbar0[c] * lit_moments4(m0, zf);
+                vis0[c] = cbar0[c] * lit_moments4(m0, zf0);
 {%- endif %}
             }
             if d > lohi1.x && d <= lohi1.y && cbar1[c] > 0.0 {
                 let m0 = mix(filtered_load(x10, row1, c * LAYERS), filtered_load(x11, row1, c * LAYERS), fx1) / cbar1[c];
 {%- if moment_count == 6 %}
                 let m1 = mix(filtered_load(x10, row1, c * LAYERS + 1u), filtered_load(x11, row1, c * LAYERS + 1u), fx1) / cbar1[c];
-                vis1[c] = cbar1[c] * lit_moments6(m0, m1.xy, zf);
+                vis1[c] = cbar1[c] * lit_moments6(m0, m1.xy, zf1);
 {%- else %}
-                vis1[c] = cbar1[c] * lit_moments4(m0, zf);
+                vis1[c] = cbar1[c] * lit_moments4(m0, zf1);
 {%- endif %}
             }
         }
@@ -390,21 +396,25 @@ fn scatter_pixel(x: u32, y: u32) -> vec3<f32> {
         // The region's moments, filtered linearly along each row (a mix of moments is the
         // moments of the mixed depths: still a valid moment vector).
         if d > lohi0.x && d <= lohi0.y {
+            // The ray's depth in the row's moment coordinate: the region's whole depth range
+            // is its bounds at its last stored column (`moment_z`).
+            let zf0 = moment_z(d, bounds[bounds_index(u32(b1) - 1u, row0)]);
             let m0 = mix(filtered_load(x00, row0, 0), filtered_load(x01, row0, 0), fx0);
 {%- if moment_count == 6 %}
             let m1 = mix(filtered_load(x00, row0, 1), filtered_load(x01, row0, 1), fx0);
-            vis0 = lit_moments6(m0, m1.xy, zf);
+            vis0 = lit_moments6(m0, m1.xy, zf0);
 {%- else %}
-            vis0 = lit_moments4(m0, zf);
+            vis0 = lit_moments4(m0, zf0);
 {%- endif %}
         }
         if d > lohi1.x && d <= lohi1.y {
+            let zf1 = moment_z(d, bounds[bounds_index(u32(b1) - 1u, row1)]);
             let m0 = mix(filtered_load(x10, row1, 0), filtered_load(x11, row1, 0), fx1);
 {%- if moment_count == 6 %}
             let m1 = mix(filtered_load(x10, row1, 1), filtered_load(x11, row1, 1), fx1);
-            vis1 = lit_moments6(m0, m1.xy, zf);
+            vis1 = lit_moments6(m0, m1.xy, zf1);
 {%- else %}
-            vis1 = lit_moments4(m0, zf);
+            vis1 = lit_moments4(m0, zf1);
 {%- endif %}
         }
 {%- else %}

@@ -9,12 +9,13 @@ use std::time::Instant;
 
 use scatter_shaderlib::prefiltered::{
     DEPTH_COLUMNS_WORKGROUP_SIZE, LightKind, PREFILTER_WORKGROUP_SIZE, PrefilteredVariant,
-    RECTIFY_WORKGROUP_SIZE, SCATTER_WORKGROUP_SIZE, SLICE_FIT_WORKGROUP_SIZE, Storage,
-    VisibilityMode,
+    RECTIFY_WORKGROUP_SIZE, Rectification, SCATTER_WORKGROUP_SIZE, SLICE_FIT_WORKGROUP_SIZE,
+    Storage, VisibilityMode,
 };
 use scatter_shaderlib::{BuiltKernel, Kernel, KernelParams, ShaderError, build, render};
 
-/// Every valid variant: bases {4, .., 128} x every bases_per_thread x regions 1..=8 x
+/// Every valid variant: bases {4, .., 128} x every bases_per_thread x regions 1..=16 (1..=8
+/// projective) x
 /// visibility x light x storage x rectification, the moment basis (4 or 6 moments) x
 /// regions x visibility x light x rectification, the spot's cookie (3 bases x visibility
 /// x rectification), and the coarse filtered columns (`filtered_stride` 2, 4, 8 x light x
@@ -31,9 +32,12 @@ fn full_cross_product_validates() {
     let variants = cross_product();
     assert_eq!(
         variants.len(),
-        21 * 8 * 2 * 2 * 3 * 2 + 2 * 8 * 2 * 2 * 2 + 3 * 2 * 2 + 3 * (2 * 2 * 2 * 5 + 4),
-        "21 (bases, bases_per_thread) pairs; 2 moment counts (rgba32float only); cookies; \
-         filtered strides"
+        21 * (8 * 2 + 8) * 2 * 3 * 2
+            + 2 * (8 * 2 + 8) * 2 * 2
+            + 3 * 2 * 2
+            + 3 * (2 * 2 * 2 * 5 + 4),
+        "21 (bases, bases_per_thread) pairs x regions (1..=8 with both rectifications, 9..=16 \
+         epipolar only); 2 moment counts (rgba32float only); cookies; filtered strides"
     );
     let start = Instant::now();
     // (kernel, rendered source) -> first parameter set that produced it.
@@ -77,11 +81,11 @@ fn full_cross_product_validates() {
     );
     // Scatter: the Fourier layer counts (6 bases values) x the 3 storage formats (the
     // `filtered` buffer's element) and the 2 moment counts (rgba32float only), each x
-    // regions x visibility x light x rectification; the cookie's 3 bases x visibility x
+    // (regions x rectification: 8 x 2 + 8 epipolar) x visibility x light; the cookie's 3 bases x visibility x
     // rectification; every coarse-column variant (its stride is in the source).
     assert_eq!(
         per_kernel[&Kernel::Scatter],
-        (6 * 3 + 2) * 8 * 2 * 2 * 2 + 3 * 2 * 2 + 3 * (2 * 2 * 2 * 5 + 4)
+        (6 * 3 + 2) * (8 * 2 + 8) * 2 * 2 + 3 * 2 * 2 + 3 * (2 * 2 * 2 * 5 + 4)
     );
     assert_eq!(per_kernel[&Kernel::Prefilter], variants.len());
     eprintln!(
@@ -123,7 +127,15 @@ fn bad_variants_are_rejected_naming_the_knob() {
         ),
         (
             PrefilteredVariant {
+                regions: 17,
+                ..PrefilteredVariant::default()
+            },
+            "regions",
+        ),
+        (
+            PrefilteredVariant {
                 regions: 9,
+                rectification: Rectification::Projective,
                 ..PrefilteredVariant::default()
             },
             "regions",

@@ -6,7 +6,8 @@
 //! visibility x light x storage x rectification, the moment basis (4 or 6 moments,
 //! rgba32float) x regions x visibility x light x rectification, and coarse filtered columns
 //! (`filtered_stride` 2, 4, 8 x light x rectification x visibility x five bases, and the spot's
-//! cookie) (the moments are stored raw,
+//! cookie), and 12 and 16 regions (Fourier m32, 4 and 6 moments x light x visibility, on a
+//! 256x32 rectified map: a directional row needs regions^2 columns) (the moments are stored raw,
 //! within the float formats' `1e-3`; the output within `1e-3 * max radiance`, as the Fourier
 //! float variants, although the reconstruction is a solve). Directional variants run on
 //! `columns/ordinary`, spot variants on `spot_grate/ordinary`, 64x36 pixels, a 128^2 shadow
@@ -30,7 +31,7 @@
 //!   `max |diff| / max radiance` without that allowance.
 //!
 //! Each variant is one libtest trial (`cargo test -p scatter-conformance --test prefiltered
-//! -- m32-t16-r4` runs those whose name contains the filter, `-- --list` lists the 2230);
+//! -- m32-t16-r4` runs those whose name contains the filter, `-- --list` lists the 2254);
 //! `prefiltered::errors::*` check the error paths.
 
 use std::process::ExitCode;
@@ -47,10 +48,26 @@ use scatter_runtime::{
 use scatter_shaderlib::family::FamilyVariant;
 use scatter_shaderlib::prefiltered::{
     FrameSettings, LightKind, PrefilteredVariant, Rectification, Resolutions, Storage,
+    VisibilityMode,
 };
 
 const SCREEN: [u32; 2] = [64, 36];
 const RECTIFIED: [u32; 2] = [64, 64];
+/// The rectified map of variants with more than 8 regions: a directional row needs
+/// `regions^2` columns (quadratic region starts), 256 for 16.
+const WIDE_RECTIFIED: [u32; 2] = [256, 32];
+/// The region counts above 8 the conformance run adds (epipolar only: a projective frame
+/// holds at most 8 regions).
+const WIDE_REGIONS: [u32; 2] = [12, 16];
+
+/// The rectified map `variant` runs on: [`WIDE_RECTIFIED`] above 8 regions.
+fn rectified_for(variant: &PrefilteredVariant) -> [u32; 2] {
+    if variant.regions > 8 {
+        WIDE_RECTIFIED
+    } else {
+        RECTIFIED
+    }
+}
 const SHADOW_MAP: u32 = 128;
 
 const RECTIFIED_TOL: f32 = 1e-4;
@@ -127,10 +144,10 @@ fn cpu_inputs(f: &Fixture) -> CpuInputs {
     }
 }
 
-fn resolutions(f: &Fixture) -> Resolutions {
+fn resolutions(f: &Fixture, variant: &PrefilteredVariant) -> Resolutions {
     Resolutions {
         screen: [f.gbuf.width, f.gbuf.height],
-        rectified: RECTIFIED,
+        rectified: rectified_for(variant),
     }
 }
 
@@ -215,7 +232,7 @@ fn trial_name(variant: &PrefilteredVariant) -> String {
 fn cpu_run(variant: &PrefilteredVariant, fixture: &Fixture) -> Result<PrefilteredRun, String> {
     run_prefiltered(
         variant,
-        RECTIFIED,
+        rectified_for(variant),
         &fixture.scene,
         &fixture.bvh,
         &fixture.gbuf,
@@ -244,7 +261,7 @@ fn run_trial(
         inputs.rectified = Some(cpu.rectified.data.clone());
     }
     let gpu_start = Instant::now();
-    let gpu = run_prefiltered_once(ctx, variant, resolutions(fixture), &inputs)
+    let gpu = run_prefiltered_once(ctx, variant, resolutions(fixture, variant), &inputs)
         .map_err(|e| format!("{trial}: GPU run failed: {e}"))?;
     let gpu_wall = gpu_start.elapsed();
     if gpu.frame.uniforms != cpu.frame.uniforms || gpu.frame.report != cpu.frame.report {
@@ -363,7 +380,7 @@ fn slice_fit_conformance(light: LightKind) -> Result<(), String> {
     let cpu = cpu_run(&variant, &fixture)?;
     let uploaded = scatter_shaderlib::prefiltered::prepare_frame(
         &variant,
-        &resolutions(&fixture),
+        &resolutions(&fixture, &variant),
         &fixture.scene.camera_desc(),
         &fixture.scene.light_desc(),
         &fixture.scene.medium_desc(),
@@ -400,7 +417,7 @@ fn slice_fit_conformance(light: LightKind) -> Result<(), String> {
 /// Runs one variant on one fixture, GPU against the mirror; `Err` lists every pass that
 /// missed its tolerance.
 fn compare(ctx: &Context, variant: &PrefilteredVariant, fixture: &Fixture) -> Result<(), String> {
-    let [wr, hr] = RECTIFIED;
+    let [wr, hr] = rectified_for(variant);
     let [w, _] = SCREEN;
     let r = run_trial(ctx, variant, fixture)?;
     let mut problems = Vec::new();
@@ -446,7 +463,28 @@ fn compare(ctx: &Context, variant: &PrefilteredVariant, fixture: &Fixture) -> Re
 }
 
 fn main() -> ExitCode {
-    let mut trials: Vec<(String, Check)> = PrefilteredVariant::grid(1..=4)
+    // The grid, then 12 and 16 regions (on the wide map) for Fourier m32 and both moment
+    // counts, every light and visibility.
+    let mut variants = PrefilteredVariant::grid(1..=4);
+    for regions in WIDE_REGIONS {
+        for base in [
+            PrefilteredVariant::default(),
+            PrefilteredVariant::with_moments(4),
+            PrefilteredVariant::with_moments(6),
+        ] {
+            for &light in LightKind::SINGLE {
+                for &visibility in VisibilityMode::ALL {
+                    variants.push(PrefilteredVariant {
+                        regions,
+                        light,
+                        visibility,
+                        ..base
+                    });
+                }
+            }
+        }
+    }
+    let mut trials: Vec<(String, Check)> = variants
         .into_iter()
         .map(|variant| {
             let check: Check = Box::new(move || conformance(&variant));
@@ -635,7 +673,16 @@ fn invalid_variant_names_the_knob() {
     let cases = [
         (
             PrefilteredVariant {
+                regions: 17,
+                ..base_variant()
+            },
+            "regions",
+            "17",
+        ),
+        (
+            PrefilteredVariant {
                 regions: 9,
+                rectification: Rectification::Projective,
                 ..base_variant()
             },
             "regions",

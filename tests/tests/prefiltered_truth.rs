@@ -141,9 +141,14 @@ fn error(f: &Fixture, variant: &PrefilteredVariant) -> f64 {
 
 /// The CPU mirror's run of `variant` and its rel L1 against the truth; panics on NaN/Inf.
 fn run(f: &Fixture, variant: &PrefilteredVariant) -> (PrefilteredRun, f64) {
+    run_at(f, variant, RECTIFIED)
+}
+
+/// [`run`] with a `rectified` map other than [`RECTIFIED`].
+fn run_at(f: &Fixture, variant: &PrefilteredVariant, rectified: [u32; 2]) -> (PrefilteredRun, f64) {
     let run = run_prefiltered(
         variant,
-        RECTIFIED,
+        rectified,
         &f.scene,
         &f.bvh,
         &f.gbuf,
@@ -474,40 +479,27 @@ fn projective_rectification_on_every_pose() {
     assert!(failures.is_empty(), "{failures:#?}");
 }
 
-/// Poses where the moment basis with 6 moments and 8 regions misses the issue's bar
-/// (3 % sun, 5 % spot): (scene/pose, measured rel L1 in %, asserted bound in %, source).
-const MOMENT_EXCEPTIONS: &[(&str, f64, f64, &str)] = &[
-    (
-        "window/ordinary",
-        8.05,
-        8.9,
-        "the reconstruction: 6 moments resolve the room's depths too coarsely where a ray's \
-         depth lies inside a region's depth range (Fourier m32-r8: 2.47 %); the bounds' \
-         midpoint is the best split measured (lower bound 20.9 %, upper 24.3 %)",
-    ),
-    (
-        "window/epipole_on_screen",
-        6.20,
-        6.9,
-        "the reconstruction, as window/ordinary (Fourier m32-r8: 2.51 %)",
-    ),
-    (
-        "window/grazing",
-        4.21,
-        4.7,
-        "the reconstruction, as window/ordinary",
-    ),
-];
+/// Poses where the moment basis with 6 moments and 16 regions misses the issue's bar
+/// (3 % sun, 5 % spot) on the 512x512 map: (scene/pose, measured rel L1 in %, asserted bound
+/// in %, source). On a 1024x1024 map it meets every bar ([`moment_basis_on_a_1024_map`]).
+const MOMENT_EXCEPTIONS: &[(&str, f64, f64, &str)] = &[(
+    "window/grazing",
+    3.20,
+    3.5,
+    "the rectified map, not the basis: at 512x512 every basis misses the bar on this pose \
+     (Fourier m32-r4 3.15 %, m32-r16 3.16 %, m64-r8 3.17 %); at 1024x1024 moments6-r16 gives \
+     1.43 % and Fourier m32-r4 1.34 %",
+)];
 
 /// The moment basis (Peters et al. 2016, `basis = moments`, rgba32float, weighted) on every
-/// suite pose: 4 and 6 moments with 3 and 8 regions, printed beside the default Fourier
-/// variant. Asserted: 6 moments with 8 regions meet the issue's bars (3 % sun, 5 % spot)
-/// except on the poses in [`MOMENT_EXCEPTIONS`]; 6 moments beat 4 on the mean over the poses
-/// at both region counts; no NaN/Inf (in [`run`]).
+/// suite pose: 4 and 6 moments with 3 and 8 regions and 6 moments with 16, printed beside the
+/// default Fourier variant. Asserted: 6 moments with 16 regions meet the issue's bars (3 %
+/// sun, 5 % spot) except on the poses in [`MOMENT_EXCEPTIONS`]; 6 moments beat 4 on the mean
+/// over the poses at 3 and 8 regions, and 16 regions beat 8; no NaN/Inf (in [`run`]).
 #[test]
 fn moment_basis_on_every_pose() {
-    let configs = [(4, 3), (6, 3), (4, 8), (6, 8)];
-    let mut sums = [0.0f64; 4];
+    let configs = [(4, 3), (6, 3), (4, 8), (6, 8), (6, 16)];
+    let mut sums = [0.0f64; 5];
     let mut failures = Vec::new();
     let mut met = 0;
     for (name, pose) in all_poses() {
@@ -543,16 +535,16 @@ fn moment_basis_on_every_pose() {
                 );
                 assert!(
                     last > bar,
-                    "{key} now meets the {bar} % bar with moments6-r8 ({last:.3} %): remove it from MOMENT_EXCEPTIONS"
+                    "{key} now meets the {bar} % bar with moments6-r16 ({last:.3} %): remove it from MOMENT_EXCEPTIONS"
                 );
                 if last > bound {
-                    failures.push(format!("moments6-r8 {key}: {last:.3} % > {bound} %"));
+                    failures.push(format!("moments6-r16 {key}: {last:.3} % > {bound} %"));
                 }
             }
             None => {
                 met += 1;
                 if last > bar {
-                    failures.push(format!("moments6-r8 {key}: {last:.3} % > {bar} %"));
+                    failures.push(format!("moments6-r16 {key}: {last:.3} % > {bar} %"));
                 }
             }
         }
@@ -560,8 +552,8 @@ fn moment_basis_on_every_pose() {
     }
     let means = sums.map(|s| s / 24.0);
     println!(
-        "means over the 24 poses: moments4-r3 {:.3} %, moments6-r3 {:.3} %, moments4-r8 {:.3} %, moments6-r8 {:.3} %; moments6-r8 meets the bar on {met} of 24 poses",
-        means[0], means[1], means[2], means[3]
+        "means over the 24 poses: moments4-r3 {:.3} %, moments6-r3 {:.3} %, moments4-r8 {:.3} %, moments6-r8 {:.3} %, moments6-r16 {:.3} %; moments6-r16 meets the bar on {met} of 24 poses",
+        means[0], means[1], means[2], means[3], means[4]
     );
     assert!(
         means[1] < means[0],
@@ -570,6 +562,48 @@ fn moment_basis_on_every_pose() {
     assert!(
         means[3] < means[2],
         "6 moments not better than 4 at 8 regions: {means:?}"
+    );
+    assert!(
+        means[4] < means[3],
+        "16 regions not better than 8 with 6 moments: {means:?}"
+    );
+    assert!(failures.is_empty(), "{failures:#?}");
+}
+
+/// The moment basis with 6 moments and 16 regions on a 1024x1024 rectified map (the bench's
+/// headline map) on every suite pose: the issue's bars (3 % sun, 5 % spot) on every one,
+/// `window` included, without exceptions; printed beside the default Fourier variant on the
+/// same map.
+#[test]
+fn moment_basis_on_a_1024_map() {
+    let mut failures = Vec::new();
+    let mut sums = [0.0f64; 2];
+    for (name, pose) in all_poses() {
+        let f = fixture(name, pose, MediumPreset::Default);
+        let light = light_of(name);
+        let bar = if light == LightKind::Spot { 5.0 } else { 3.0 };
+        let fourier = PrefilteredVariant {
+            light,
+            ..PrefilteredVariant::default()
+        };
+        let moments = PrefilteredVariant {
+            light,
+            regions: 16,
+            ..PrefilteredVariant::with_moments(6)
+        };
+        let ef = 100.0 * run_at(&f, &fourier, [1024, 1024]).1;
+        let em = 100.0 * run_at(&f, &moments, [1024, 1024]).1;
+        sums[0] += ef;
+        sums[1] += em;
+        println!("{name}/{pose} (1024x1024): fourier m32-r4 {ef:.3} %, moments6-r16 {em:.3} %");
+        if em > bar {
+            failures.push(format!("moments6-r16 {name}/{pose}: {em:.3} % > {bar} %"));
+        }
+    }
+    println!(
+        "means over the 24 poses (1024x1024): fourier m32-r4 {:.3} %, moments6-r16 {:.3} %",
+        sums[0] / 24.0,
+        sums[1] / 24.0
     );
     assert!(failures.is_empty(), "{failures:#?}");
 }

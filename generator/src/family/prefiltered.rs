@@ -14,7 +14,7 @@ const BASES_ALLOWED: &str = "a multiple of 4 in 4..=128";
 /// Allowed `bases_per_thread`.
 const BASES_PER_THREAD_ALLOWED: &str = "a multiple of 4 that divides bases";
 /// Allowed `regions`.
-const REGIONS_ALLOWED: &str = "in 1..=8";
+const REGIONS_ALLOWED: &str = "in 1..=16 (1..=8 with rectification = projective)";
 /// Allowed `moments`.
 const MOMENTS_ALLOWED: &str = "4 or 6";
 /// Allowed `filtered_stride`.

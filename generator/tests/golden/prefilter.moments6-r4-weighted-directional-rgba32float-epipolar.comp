@@ -59,6 +59,7 @@ const float PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = 3.1415927;
 const vec4 GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = vec4(-0.8611363, -0.33998105, 0.33998105, 0.8611363);
 const vec4 GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = vec4(0.34785485, 0.65214515, 0.65214515, 0.34785485);
 const float CONE_FLOORX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX = 0.001;
+const float MOMENT_RANGE_FLOORX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX = 0.1;
 const uint STRIDE = 1u;
 const uint REGIONS = 4u;
 const uint BASES_PER_THREAD = 6u;
@@ -184,11 +185,11 @@ float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye, vec3 dir,
     vec3 x_8 = (eye + (dir * t));
     vec3 to_x = (x_8 - light_pos);
     float d2_ = max(dot(to_x, to_x), 1e-12);
-    float d_1 = sqrt(d2_);
-    vec3 travel = (to_x / vec3(d_1));
+    float d_2 = sqrt(d2_);
+    vec3 travel = (to_x / vec3(d_2));
     float _e17 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(travel, light_dir), cos_inner_1, cos_outer_1);
     float _e22 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(medium.z, -(dot(travel, dir)));
-    return ((((medium.y * _e22) * _e17) * exp((-(medium.x) * (d_1 + t)))) / d2_);
+    return ((((medium.y * _e22) * _e17) * exp((-(medium.x) * (d_2 + t)))) / d2_);
 }
 
 float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(vec3 eye_1, vec3 dir_1, float a_1, float b_1, uint panels, vec3 light_pos_1, vec3 light_dir_1, float cos_inner_2, float cos_outer_2, vec4 medium_1) {
@@ -336,17 +337,17 @@ float ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_oil_mod
     }
 }
 
-float texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7, SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX s_1, vec3 e_1, uint i_1, bool weighted, bool spot_3) {
+float texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7, SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX s_1, vec3 e_1, uint i_2, bool weighted, bool spot_3) {
     float w = 0.0;
-    float _e5 = ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_7, s_1, float(i_1), spot_3);
-    float _e9 = ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_7, s_1, float((i_1 + 1u)), spot_3);
+    float _e5 = ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_7, s_1, float(i_2), spot_3);
+    float _e9 = ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_7, s_1, float((i_2 + 1u)), spot_3);
     if (!(weighted)) {
         return (_e9 - _e5);
     }
     float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_7.medium.x, _e5, _e9);
     w = _e15;
     if (spot_3) {
-        float psi_1 = ((float(i_1) + 0.5) * s_1.delta);
+        float psi_1 = ((float(i_2) + 0.5) * s_1.delta);
         vec3 l_1 = ((-(f_7.axis.xyz) * cos(psi_1)) + (e_1 * sin(psi_1)));
         float den_1 = max(sin((s_1.theta_ref + psi_1)), 0.0001);
         float r_2 = max(((f_7.axis.w * sin(s_1.theta_ref)) / den_1), 0.0001);
@@ -359,8 +360,8 @@ float texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_
     return _e64;
 }
 
-float moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(float d) {
-    return ((2.0 * d) - 1.0);
+float moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(float d_1, vec2 range) {
+    return (((2.0 * d_1) - (range.x + range.y)) / max((range.y - range.x), MOMENT_RANGE_FLOORX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX));
 }
 
 vec4 moment_layerX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(float z_1, uint layer) {
@@ -399,106 +400,135 @@ void main() {
     float wsum = 0.0;
     float lo = 1e30;
     float hi = -1e30;
+    vec2 depth_range = vec2(1e30, -1e30);
     uint i = 0u;
+    float d = 0.0;
+    uint i_1 = 0u;
     uint q = 0u;
     uint row_6 = id.x;
     uint region = id.y;
     uint thread = id.z;
     uint width_2 = _group_0_binding_0_cs.sizes.z;
-    uint _e14 = _group_0_binding_0_cs.sizes.w;
-    if (!((row_6 >= _e14))) {
+    uint _e15 = _group_0_binding_0_cs.sizes.w;
+    if (!((row_6 >= _e15))) {
         local = (region >= REGIONS);
     } else {
         local = true;
     }
-    bool _e22 = local;
-    if (!(_e22)) {
+    bool _e23 = local;
+    if (!(_e23)) {
         local_1 = (thread >= THREADS_PER_ROW_REGION);
     } else {
         local_1 = true;
     }
-    bool _e29 = local_1;
-    if (_e29) {
+    bool _e30 = local_1;
+    if (_e30) {
         return;
     }
-    vec4 _e32 = _group_0_binding_1_cs[row_6];
-    SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e33 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e32);
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e35 = _group_0_binding_0_cs;
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e37 = _group_0_binding_0_cs;
-    float _e38 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e37, row_6);
-    vec3 _e39 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e35, _e38);
-    uint _e43 = region_columnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(region, REGIONS, width_2, STRIDE, false);
-    uint _e48 = region_columnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((region + 1u), REGIONS, width_2, STRIDE, false);
-    i = _e43;
+    vec4 _e33 = _group_0_binding_1_cs[row_6];
+    SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e34 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e33);
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e36 = _group_0_binding_0_cs;
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e38 = _group_0_binding_0_cs;
+    float _e39 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e38, row_6);
+    vec3 _e40 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e36, _e39);
+    uint _e44 = region_columnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(region, REGIONS, width_2, STRIDE, false);
+    uint _e49 = region_columnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((region + 1u), REGIONS, width_2, STRIDE, false);
+    i = _e44;
     bool loop_init_2 = true;
     while(true) {
         if (!loop_init_2) {
-            uint _e126 = i;
-            i = (_e126 + 1u);
+            uint _e71 = i;
+            i = (_e71 + 1u);
         }
         loop_init_2 = false;
-        uint _e50 = i;
-        if ((_e50 < _e48)) {
+        uint _e51 = i;
+        if ((_e51 < _e49)) {
         } else {
             break;
         }
         {
-            uint _e52 = i;
-            int _e56_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_2_cs) - 1);
-            vec4 _e56 = texelFetch(_group_0_binding_2_cs, clamp(ivec2(uvec2(_e52, row_6)), ivec2(0), textureSize(_group_0_binding_2_cs, _e56_clamped_lod) - ivec2(1)), _e56_clamped_lod);
-            float d_2 = _e56.x;
-            FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e59 = _group_0_binding_0_cs;
-            uint _e60 = i;
-            float _e62 = texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e59, _e33, _e39, _e60, true, false);
-            float _e64 = wsum;
-            wsum = (_e64 + _e62);
-            uint _e66 = i;
-            bool store = ((_e66 % STRIDE) == 0u);
-            uint _e71 = i;
-            uint x_9 = (_e71 / STRIDE);
+            uint _e53 = i;
+            int _e57_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_2_cs) - 1);
+            vec4 _e57 = texelFetch(_group_0_binding_2_cs, clamp(ivec2(uvec2(_e53, row_6)), ivec2(0), textureSize(_group_0_binding_2_cs, _e57_clamped_lod) - ivec2(1)), _e57_clamped_lod);
+            d = _e57.x;
+            float _e62 = depth_range.x;
+            float _e63 = d;
+            float _e66 = depth_range.y;
+            float _e67 = d;
+            depth_range = vec2(min(_e62, _e63), max(_e66, _e67));
+        }
+    }
+    i_1 = _e44;
+    bool loop_init_3 = true;
+    while(true) {
+        if (!loop_init_3) {
+            uint _e151 = i_1;
+            i_1 = (_e151 + 1u);
+        }
+        loop_init_3 = false;
+        uint _e74 = i_1;
+        if ((_e74 < _e49)) {
+        } else {
+            break;
+        }
+        {
+            uint _e76 = i_1;
+            int _e80_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_2_cs) - 1);
+            vec4 _e80 = texelFetch(_group_0_binding_2_cs, clamp(ivec2(uvec2(_e76, row_6)), ivec2(0), textureSize(_group_0_binding_2_cs, _e80_clamped_lod) - ivec2(1)), _e80_clamped_lod);
+            float d_3 = _e80.x;
+            FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e83 = _group_0_binding_0_cs;
+            uint _e84 = i_1;
+            float _e86 = texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e83, _e34, _e40, _e84, true, false);
+            float _e88 = wsum;
+            wsum = (_e88 + _e86);
+            uint _e90 = i_1;
+            bool store = ((_e90 % STRIDE) == 0u);
+            uint _e95 = i_1;
+            uint x_9 = (_e95 / STRIDE);
             if ((thread == 0u)) {
-                float _e77 = lo;
-                lo = min(_e77, d_2);
-                float _e80 = hi;
-                hi = max(_e80, d_2);
+                float _e101 = lo;
+                lo = min(_e101, d_3);
+                float _e104 = hi;
+                hi = max(_e104, d_3);
                 if (store) {
-                    uint _e82 = bounds_index(x_9, row_6);
-                    float _e85 = lo;
-                    float _e86 = hi;
-                    _group_0_binding_4_cs[_e82] = vec2(_e85, _e86);
+                    uint _e106 = bounds_index(x_9, row_6);
+                    float _e109 = lo;
+                    float _e110 = hi;
+                    _group_0_binding_4_cs[_e106] = vec2(_e109, _e110);
                 }
             }
-            float _e88 = wsum;
-            float _e90 = wsum;
-            float blend = ((_e90 > 0.0) ? (_e62 / _e88) : 0.0);
-            float _e95 = moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(d_2);
+            float _e112 = wsum;
+            float _e114 = wsum;
+            float blend = ((_e114 > 0.0) ? (_e86 / _e112) : 0.0);
+            vec2 _e119 = depth_range;
+            float _e120 = moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(d_3, _e119);
             q = 0u;
-            bool loop_init_3 = true;
+            bool loop_init_4 = true;
             while(true) {
-                if (!loop_init_3) {
-                    uint _e123 = q;
-                    q = (_e123 + 1u);
+                if (!loop_init_4) {
+                    uint _e148 = q;
+                    q = (_e148 + 1u);
                 }
-                loop_init_3 = false;
-                uint _e99 = q;
-                if ((_e99 < 2u)) {
+                loop_init_4 = false;
+                uint _e124 = q;
+                if ((_e124 < 2u)) {
                 } else {
                     break;
                 }
                 {
-                    uint _e102 = q;
-                    uint _e104 = q;
-                    vec4 _e106 = acc[_e104];
-                    uint _e110 = q;
-                    vec4 _e111 = moment_layerX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(_e95, _e110);
-                    acc[_e102] = ((_e106 * (1.0 - blend)) + (_e111 * blend));
+                    uint _e127 = q;
+                    uint _e129 = q;
+                    vec4 _e131 = acc[_e129];
+                    uint _e135 = q;
+                    vec4 _e136 = moment_layerX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(_e120, _e135);
+                    acc[_e127] = ((_e131 * (1.0 - blend)) + (_e136 * blend));
                     if (store) {
-                        uint _e114 = q;
-                        uint _e115 = filtered_index(x_9, row_6, _e114);
-                        uint _e118 = q;
-                        vec4 _e120 = acc[_e118];
-                        vec4 _e121 = encode_layer(_e120);
-                        _group_0_binding_3_cs[_e115] = _e121;
+                        uint _e139 = q;
+                        uint _e140 = filtered_index(x_9, row_6, _e139);
+                        uint _e143 = q;
+                        vec4 _e145 = acc[_e143];
+                        vec4 _e146 = encode_layer(_e145);
+                        _group_0_binding_3_cs[_e140] = _e146;
                     }
                 }
             }

@@ -58,6 +58,7 @@ static const float PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = 3.1415927;
 static const float4 GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = float4(-0.8611363, -0.33998105, 0.33998105, 0.8611363);
 static const float4 GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = float4(0.34785485, 0.65214515, 0.65214515, 0.34785485);
 static const float CONE_FLOORX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX = 0.001;
+static const float MOMENT_RANGE_FLOORX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX = 0.1;
 static const uint STRIDE = 1u;
 static const uint REGIONS = 4u;
 static const uint BASES_PER_THREAD = 6u;
@@ -195,11 +196,11 @@ float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye, float3 
     float3 x_8 = (eye + (dir * t));
     float3 to_x = (x_8 - light_pos);
     float d2_ = max(dot(to_x, to_x), 1e-12);
-    float d_1 = sqrt(d2_);
-    float3 travel = (to_x / (d_1).xxx);
+    float d_2 = sqrt(d2_);
+    float3 travel = (to_x / (d_2).xxx);
     const float _e17 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(travel, light_dir), cos_inner_1, cos_outer_1);
     const float _e22 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(medium.z, -(dot(travel, dir)));
-    return ((((medium.y * _e22) * _e17) * exp((-(medium.x) * (d_1 + t)))) / d2_);
+    return ((((medium.y * _e22) * _e17) * exp((-(medium.x) * (d_2 + t)))) / d2_);
 }
 
 float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(float3 eye_1, float3 dir_1, float a_1, float b_1, uint panels, float3 light_pos_1, float3 light_dir_1, float cos_inner_2, float cos_outer_2, float4 medium_1)
@@ -393,19 +394,19 @@ float ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_oil_mod
     }
 }
 
-float texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7, SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX s_1, float3 e_1, uint i_1, bool weighted, bool spot_3)
+float texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7, SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX s_1, float3 e_1, uint i_2, bool weighted, bool spot_3)
 {
     float w = (float)0;
 
-    const float _e5 = ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_7, s_1, float(i_1), spot_3);
-    const float _e9 = ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_7, s_1, float((i_1 + 1u)), spot_3);
+    const float _e5 = ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_7, s_1, float(i_2), spot_3);
+    const float _e9 = ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_7, s_1, float((i_2 + 1u)), spot_3);
     if (!(weighted)) {
         return (_e9 - _e5);
     }
     const float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_7.medium.x, _e5, _e9);
     w = _e15;
     if (spot_3) {
-        float psi_1 = ((float(i_1) + 0.5) * s_1.delta);
+        float psi_1 = ((float(i_2) + 0.5) * s_1.delta);
         float3 l_1 = ((-(f_7.axis.xyz) * cos(psi_1)) + (e_1 * sin(psi_1)));
         float den_1 = max(sin((s_1.theta_ref + psi_1)), 0.0001);
         float r_2 = max(((f_7.axis.w * sin(s_1.theta_ref)) / den_1), 0.0001);
@@ -418,9 +419,9 @@ float texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(FrameX_naga_
     return _e64;
 }
 
-float moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(float d)
+float moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(float d_1, float2 range)
 {
-    return ((2.0 * d) - 1.0);
+    return (((2.0 * d_1) - (range.x + range.y)) / max((range.y - range.x), MOMENT_RANGE_FLOORX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX));
 }
 
 float4 moment_layerX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(float z_1, uint layer)
@@ -477,112 +478,143 @@ void prefilter(uint3 id : SV_DispatchThreadID)
     float wsum = 0.0;
     float lo = 1e30;
     float hi = -1e30;
+    float2 depth_range = float2(1e30, -1e30);
     uint i = (uint)0;
+    float d = (float)0;
+    uint i_1 = (uint)0;
     uint q = (uint)0;
 
     uint row_6 = id.x;
     uint region = id.y;
     uint thread = id.z;
     uint width_2 = frame.sizes.z;
-    uint _e14 = frame.sizes.w;
-    if (!((row_6 >= _e14))) {
+    uint _e15 = frame.sizes.w;
+    if (!((row_6 >= _e15))) {
         local = (region >= REGIONS);
     } else {
         local = true;
     }
-    bool _e22 = local;
-    if (!(_e22)) {
+    bool _e23 = local;
+    if (!(_e23)) {
         local_1 = (thread >= THREADS_PER_ROW_REGION);
     } else {
         local_1 = true;
     }
-    bool _e29 = local_1;
-    if (_e29) {
+    bool _e30 = local_1;
+    if (_e30) {
         return;
     }
-    float4 _e32 = asfloat(slices.Load4(row_6*16));
-    const SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e33 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e32);
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e35 = frame;
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e37 = frame;
-    const float _e38 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e37, row_6);
-    const float3 _e39 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e35, _e38);
-    const uint _e43 = region_columnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(region, REGIONS, width_2, STRIDE, false);
-    const uint _e48 = region_columnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((region + 1u), REGIONS, width_2, STRIDE, false);
-    i = _e43;
+    float4 _e33 = asfloat(slices.Load4(row_6*16));
+    const SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e34 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e33);
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e36 = frame;
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e38 = frame;
+    const float _e39 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e38, row_6);
+    const float3 _e40 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e36, _e39);
+    const uint _e44 = region_columnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(region, REGIONS, width_2, STRIDE, false);
+    const uint _e49 = region_columnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((region + 1u), REGIONS, width_2, STRIDE, false);
+    i = _e44;
     uint2 loop_bound_2 = uint2(4294967295u, 4294967295u);
     bool loop_init_2 = true;
     while(true) {
         if (all(loop_bound_2 == uint2(0u, 0u))) { break; }
         loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
         if (!loop_init_2) {
-            uint _e126 = i;
-            i = (_e126 + 1u);
+            uint _e71 = i;
+            i = (_e71 + 1u);
         }
         loop_init_2 = false;
-        uint _e50 = i;
-        if ((_e50 < _e48)) {
+        uint _e51 = i;
+        if ((_e51 < _e49)) {
         } else {
             break;
         }
         {
-            uint _e52 = i;
-            float4 _e56 = rectified.Load(int3(uint2(_e52, row_6), int(0)));
-            float d_2 = _e56.x;
-            FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e59 = frame;
-            uint _e60 = i;
-            const float _e62 = texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e59, _e33, _e39, _e60, true, false);
-            float _e64 = wsum;
-            wsum = (_e64 + _e62);
-            uint _e66 = i;
-            bool store = (naga_mod(_e66, STRIDE) == 0u);
-            uint _e71 = i;
-            uint x_9 = naga_div(_e71, STRIDE);
+            uint _e53 = i;
+            float4 _e57 = rectified.Load(int3(uint2(_e53, row_6), int(0)));
+            d = _e57.x;
+            float _e62 = depth_range.x;
+            float _e63 = d;
+            float _e66 = depth_range.y;
+            float _e67 = d;
+            depth_range = float2(min(_e62, _e63), max(_e66, _e67));
+        }
+    }
+    i_1 = _e44;
+    uint2 loop_bound_3 = uint2(4294967295u, 4294967295u);
+    bool loop_init_3 = true;
+    while(true) {
+        if (all(loop_bound_3 == uint2(0u, 0u))) { break; }
+        loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
+        if (!loop_init_3) {
+            uint _e151 = i_1;
+            i_1 = (_e151 + 1u);
+        }
+        loop_init_3 = false;
+        uint _e74 = i_1;
+        if ((_e74 < _e49)) {
+        } else {
+            break;
+        }
+        {
+            uint _e76 = i_1;
+            float4 _e80 = rectified.Load(int3(uint2(_e76, row_6), int(0)));
+            float d_3 = _e80.x;
+            FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e83 = frame;
+            uint _e84 = i_1;
+            const float _e86 = texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e83, _e34, _e40, _e84, true, false);
+            float _e88 = wsum;
+            wsum = (_e88 + _e86);
+            uint _e90 = i_1;
+            bool store = (naga_mod(_e90, STRIDE) == 0u);
+            uint _e95 = i_1;
+            uint x_9 = naga_div(_e95, STRIDE);
             if ((thread == 0u)) {
-                float _e77 = lo;
-                lo = min(_e77, d_2);
-                float _e80 = hi;
-                hi = max(_e80, d_2);
+                float _e101 = lo;
+                lo = min(_e101, d_3);
+                float _e104 = hi;
+                hi = max(_e104, d_3);
                 if (store) {
-                    const uint _e82 = bounds_index(x_9, row_6);
-                    float _e85 = lo;
-                    float _e86 = hi;
-                    bounds.Store2(_e82*8, asuint(float2(_e85, _e86)));
+                    const uint _e106 = bounds_index(x_9, row_6);
+                    float _e109 = lo;
+                    float _e110 = hi;
+                    bounds.Store2(_e106*8, asuint(float2(_e109, _e110)));
                 }
             }
-            float _e88 = wsum;
-            float _e90 = wsum;
-            float blend = ((_e90 > 0.0) ? (_e62 / _e88) : 0.0);
-            const float _e95 = moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(d_2);
+            float _e112 = wsum;
+            float _e114 = wsum;
+            float blend = ((_e114 > 0.0) ? (_e86 / _e112) : 0.0);
+            float2 _e119 = depth_range;
+            const float _e120 = moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(d_3, _e119);
             q = 0u;
-            uint2 loop_bound_3 = uint2(4294967295u, 4294967295u);
-            bool loop_init_3 = true;
+            uint2 loop_bound_4 = uint2(4294967295u, 4294967295u);
+            bool loop_init_4 = true;
             while(true) {
-                if (all(loop_bound_3 == uint2(0u, 0u))) { break; }
-                loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
-                if (!loop_init_3) {
-                    uint _e123 = q;
-                    q = (_e123 + 1u);
+                if (all(loop_bound_4 == uint2(0u, 0u))) { break; }
+                loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
+                if (!loop_init_4) {
+                    uint _e148 = q;
+                    q = (_e148 + 1u);
                 }
-                loop_init_3 = false;
-                uint _e99 = q;
-                if ((_e99 < 2u)) {
+                loop_init_4 = false;
+                uint _e124 = q;
+                if ((_e124 < 2u)) {
                 } else {
                     break;
                 }
                 {
-                    uint _e102 = q;
-                    uint _e104 = q;
-                    float4 _e106 = acc[min(uint(_e104), 1u)];
-                    uint _e110 = q;
-                    const float4 _e111 = moment_layerX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(_e95, _e110);
-                    acc[min(uint(_e102), 1u)] = ((_e106 * (1.0 - blend)) + (_e111 * blend));
+                    uint _e127 = q;
+                    uint _e129 = q;
+                    float4 _e131 = acc[min(uint(_e129), 1u)];
+                    uint _e135 = q;
+                    const float4 _e136 = moment_layerX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(_e120, _e135);
+                    acc[min(uint(_e127), 1u)] = ((_e131 * (1.0 - blend)) + (_e136 * blend));
                     if (store) {
-                        uint _e114 = q;
-                        const uint _e115 = filtered_index(x_9, row_6, _e114);
-                        uint _e118 = q;
-                        float4 _e120 = acc[min(uint(_e118), 1u)];
-                        const float4 _e121 = encode_layer(_e120);
-                        filtered.Store4(_e115*16, asuint(_e121));
+                        uint _e139 = q;
+                        const uint _e140 = filtered_index(x_9, row_6, _e139);
+                        uint _e143 = q;
+                        float4 _e145 = acc[min(uint(_e143), 1u)];
+                        const float4 _e146 = encode_layer(_e145);
+                        filtered.Store4(_e140*16, asuint(_e146));
                     }
                 }
             }

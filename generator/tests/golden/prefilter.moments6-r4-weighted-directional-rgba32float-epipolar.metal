@@ -71,6 +71,7 @@ constant float PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = 3.1415927;
 constant metal::float4 GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = metal::float4(-0.8611363, -0.33998105, 0.33998105, 0.8611363);
 constant metal::float4 GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = metal::float4(0.34785485, 0.65214515, 0.65214515, 0.34785485);
 constant float CONE_FLOORX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX = 0.001;
+constant float MOMENT_RANGE_FLOORX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX = 0.1;
 constant uint STRIDE = 1u;
 constant uint REGIONS = 4u;
 constant uint BASES_PER_THREAD = 6u;
@@ -243,11 +244,11 @@ float spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
     metal::float3 x_8 = eye + (dir * t);
     metal::float3 to_x = x_8 - light_pos;
     float d2_ = metal::max(metal::dot(to_x, to_x), 0.000000000001);
-    float d_1 = metal::sqrt(d2_);
-    metal::float3 travel = to_x / metal::float3(d_1);
+    float d_2 = metal::sqrt(d2_);
+    metal::float3 travel = to_x / metal::float3(d_2);
     float _e17 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(metal::dot(travel, light_dir), cos_inner_1, cos_outer_1);
     float _e22 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(medium.z, -(metal::dot(travel, dir)));
-    return (((medium.y * _e22) * _e17) * metal::exp(-(medium.x) * (d_1 + t))) / d2_;
+    return (((medium.y * _e22) * _e17) * metal::exp(-(medium.x) * (d_2 + t))) / d2_;
 }
 
 float spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(
@@ -469,20 +470,20 @@ float texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_7,
     SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX s_1,
     metal::float3 e_1,
-    uint i_1,
+    uint i_2,
     bool weighted,
     bool spot_3
 ) {
     float w = {};
-    float _e5 = ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_7, s_1, static_cast<float>(i_1), spot_3);
-    float _e9 = ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_7, s_1, static_cast<float>(i_1 + 1u), spot_3);
+    float _e5 = ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_7, s_1, static_cast<float>(i_2), spot_3);
+    float _e9 = ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_7, s_1, static_cast<float>(i_2 + 1u), spot_3);
     if (!(weighted)) {
         return _e9 - _e5;
     }
     float _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_7.medium.x, _e5, _e9);
     w = _e15;
     if (spot_3) {
-        float psi_1 = (static_cast<float>(i_1) + 0.5) * s_1.delta;
+        float psi_1 = (static_cast<float>(i_2) + 0.5) * s_1.delta;
         metal::float3 l_1 = (-(f_7.axis.xyz) * metal::cos(psi_1)) + (e_1 * metal::sin(psi_1));
         float den_1 = metal::max(metal::sin(s_1.theta_ref + psi_1), 0.0001);
         float r_2 = metal::max((f_7.axis.w * metal::sin(s_1.theta_ref)) / den_1, 0.0001);
@@ -496,9 +497,10 @@ float texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(
 }
 
 float moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(
-    float d
+    float d_1,
+    metal::float2 range
 ) {
-    return (2.0 * d) - 1.0;
+    return ((2.0 * d_1) - (range.x + range.y)) / metal::max(range.y - range.x, MOMENT_RANGE_FLOORX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX);
 }
 
 metal::float4 moment_layerX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(
@@ -580,112 +582,144 @@ kernel void prefilter(
     float wsum = 0.0;
     float lo = 1000000000000000000000000000000.0;
     float hi = -1000000000000000000000000000000.0;
+    metal::float2 depth_range = metal::float2(1000000000000000000000000000000.0, -1000000000000000000000000000000.0);
     uint i = {};
+    float d = {};
+    uint i_1 = {};
     uint q = {};
     uint row_6 = id.x;
     uint region = id.y;
     uint thread_ = id.z;
     uint width_2 = frame.sizes.z;
-    uint _e14 = frame.sizes.w;
-    if (!((row_6 >= _e14))) {
+    uint _e15 = frame.sizes.w;
+    if (!((row_6 >= _e15))) {
         local = region >= REGIONS;
     } else {
         local = true;
     }
-    bool _e22 = local;
-    if (!(_e22)) {
+    bool _e23 = local;
+    if (!(_e23)) {
         local_1 = thread_ >= THREADS_PER_ROW_REGION;
     } else {
         local_1 = true;
     }
-    bool _e29 = local_1;
-    if (_e29) {
+    bool _e30 = local_1;
+    if (_e30) {
         return;
     }
-    metal::float4 _e32 = slices[metal::min(unsigned(row_6), (_buffer_sizes.size1 - 0 - 16) / 16)];
-    SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e33 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e32);
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e35 = frame;
-    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e37 = frame;
-    float _e38 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e37, row_6);
-    metal::float3 _e39 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e35, _e38);
-    uint _e43 = region_columnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(region, REGIONS, width_2, STRIDE, false);
-    uint _e48 = region_columnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(region + 1u, REGIONS, width_2, STRIDE, false);
-    i = _e43;
+    metal::float4 _e33 = slices[metal::min(unsigned(row_6), (_buffer_sizes.size1 - 0 - 16) / 16)];
+    SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e34 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e33);
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e36 = frame;
+    FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e38 = frame;
+    float _e39 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e38, row_6);
+    metal::float3 _e40 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e36, _e39);
+    uint _e44 = region_columnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(region, REGIONS, width_2, STRIDE, false);
+    uint _e49 = region_columnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(region + 1u, REGIONS, width_2, STRIDE, false);
+    i = _e44;
     uint2 loop_bound_2 = uint2(4294967295u);
     bool loop_init_2 = true;
     while(true) {
         if (metal::all(loop_bound_2 == uint2(0u))) { break; }
         loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
         if (!loop_init_2) {
-            uint _e126 = i;
-            i = _e126 + 1u;
+            uint _e71 = i;
+            i = _e71 + 1u;
         }
         loop_init_2 = false;
-        uint _e50 = i;
-        if (_e50 < _e48) {
+        uint _e51 = i;
+        if (_e51 < _e49) {
         } else {
             break;
         }
         {
-            uint _e52 = i;
-            uint clamped_lod_e56 = metal::min(uint(0), rectified.get_num_mip_levels() - 1);
-            metal::float4 _e56 = rectified.read(metal::min(metal::uint2(metal::uint2(_e52, row_6)), metal::uint2(rectified.get_width(clamped_lod_e56), rectified.get_height(clamped_lod_e56)) - 1), clamped_lod_e56);
-            float d_2 = _e56.x;
-            FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e59 = frame;
-            uint _e60 = i;
-            float _e62 = texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e59, _e33, _e39, _e60, true, false);
-            float _e64 = wsum;
-            wsum = _e64 + _e62;
-            uint _e66 = i;
-            bool store = naga_mod(_e66, STRIDE) == 0u;
-            uint _e71 = i;
-            uint x_9 = naga_div(_e71, STRIDE);
+            uint _e53 = i;
+            uint clamped_lod_e57 = metal::min(uint(0), rectified.get_num_mip_levels() - 1);
+            metal::float4 _e57 = rectified.read(metal::min(metal::uint2(metal::uint2(_e53, row_6)), metal::uint2(rectified.get_width(clamped_lod_e57), rectified.get_height(clamped_lod_e57)) - 1), clamped_lod_e57);
+            d = _e57.x;
+            float _e62 = depth_range.x;
+            float _e63 = d;
+            float _e66 = depth_range.y;
+            float _e67 = d;
+            depth_range = metal::float2(metal::min(_e62, _e63), metal::max(_e66, _e67));
+        }
+    }
+    i_1 = _e44;
+    uint2 loop_bound_3 = uint2(4294967295u);
+    bool loop_init_3 = true;
+    while(true) {
+        if (metal::all(loop_bound_3 == uint2(0u))) { break; }
+        loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
+        if (!loop_init_3) {
+            uint _e151 = i_1;
+            i_1 = _e151 + 1u;
+        }
+        loop_init_3 = false;
+        uint _e74 = i_1;
+        if (_e74 < _e49) {
+        } else {
+            break;
+        }
+        {
+            uint _e76 = i_1;
+            uint clamped_lod_e80 = metal::min(uint(0), rectified.get_num_mip_levels() - 1);
+            metal::float4 _e80 = rectified.read(metal::min(metal::uint2(metal::uint2(_e76, row_6)), metal::uint2(rectified.get_width(clamped_lod_e80), rectified.get_height(clamped_lod_e80)) - 1), clamped_lod_e80);
+            float d_3 = _e80.x;
+            FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e83 = frame;
+            uint _e84 = i_1;
+            float _e86 = texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e83, _e34, _e40, _e84, true, false);
+            float _e88 = wsum;
+            wsum = _e88 + _e86;
+            uint _e90 = i_1;
+            bool store = naga_mod(_e90, STRIDE) == 0u;
+            uint _e95 = i_1;
+            uint x_9 = naga_div(_e95, STRIDE);
             if (thread_ == 0u) {
-                float _e77 = lo;
-                lo = metal::min(_e77, d_2);
-                float _e80 = hi;
-                hi = metal::max(_e80, d_2);
+                float _e101 = lo;
+                lo = metal::min(_e101, d_3);
+                float _e104 = hi;
+                hi = metal::max(_e104, d_3);
                 if (store) {
-                    uint _e82 = bounds_index(x_9, row_6, frame);
-                    float _e85 = lo;
-                    float _e86 = hi;
-                    bounds[metal::min(unsigned(_e82), (_buffer_sizes.size4 - 0 - 8) / 8)] = metal::float2(_e85, _e86);
+                    uint _e106 = bounds_index(x_9, row_6, frame);
+                    float _e109 = lo;
+                    float _e110 = hi;
+                    bounds[metal::min(unsigned(_e106), (_buffer_sizes.size4 - 0 - 8) / 8)] = metal::float2(_e109, _e110);
                 }
             }
-            float _e88 = wsum;
-            float _e90 = wsum;
-            float blend = (_e90 > 0.0) ? (_e62 / _e88) : 0.0;
-            float _e95 = moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(d_2);
+            float _e112 = wsum;
+            float _e114 = wsum;
+            float blend = (_e114 > 0.0) ? (_e86 / _e112) : 0.0;
+            metal::float2 _e119 = depth_range;
+            float _e120 = moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(d_3, _e119);
             q = 0u;
-            uint2 loop_bound_3 = uint2(4294967295u);
-            bool loop_init_3 = true;
+            uint2 loop_bound_4 = uint2(4294967295u);
+            bool loop_init_4 = true;
             while(true) {
-                if (metal::all(loop_bound_3 == uint2(0u))) { break; }
-                loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
-                if (!loop_init_3) {
-                    uint _e123 = q;
-                    q = _e123 + 1u;
+                if (metal::all(loop_bound_4 == uint2(0u))) { break; }
+                loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
+                if (!loop_init_4) {
+                    uint _e148 = q;
+                    q = _e148 + 1u;
                 }
-                loop_init_3 = false;
-                uint _e99 = q;
-                if (_e99 < 2u) {
+                loop_init_4 = false;
+                uint _e124 = q;
+                if (_e124 < 2u) {
                 } else {
                     break;
                 }
                 {
-                    uint _e102 = q;
-                    uint _e104 = q;
-                    metal::float4 _e106 = acc.inner[metal::min(unsigned(_e104), 1u)];
-                    uint _e110 = q;
-                    metal::float4 _e111 = moment_layerX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(_e95, _e110);
-                    acc.inner[metal::min(unsigned(_e102), 1u)] = (_e106 * (1.0 - blend)) + (_e111 * blend);
+                    uint _e127 = q;
+                    uint _e129 = q;
+                    metal::float4 _e131 = acc.inner[metal::min(unsigned(_e129), 1u)];
+                    uint _e135 = q;
+                    metal::float4 _e136 = moment_layerX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(_e120, _e135);
+                    acc.inner[metal::min(unsigned(_e127), 1u)] = (_e131 * (1.0 - blend)) + (_e136 * blend);
                     if (store) {
-                        uint _e114 = q;
-                        uint _e115 = filtered_index(x_9, row_6, _e114, frame);
-                        uint _e118 = q;
-                        metal::float4 _e120 = acc.inner[metal::min(unsigned(_e118), 1u)];
-                        metal::float4 _e121 = encode_layer(_e120);
-                        filtered[metal::min(unsigned(_e115), (_buffer_sizes.size3 - 0 - 16) / 16)] = _e121;
+                        uint _e139 = q;
+                        uint _e140 = filtered_index(x_9, row_6, _e139, frame);
+                        uint _e143 = q;
+                        metal::float4 _e145 = acc.inner[metal::min(unsigned(_e143), 1u)];
+                        metal::float4 _e146 = encode_layer(_e145);
+                        filtered[metal::min(unsigned(_e140), (_buffer_sizes.size3 - 0 - 16) / 16)] = _e146;
                     }
                 }
             }

@@ -58,6 +58,7 @@ const PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX: f32 = 3.1415927f;
 const GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX: vec4<f32> = vec4<f32>(-0.8611363f, -0.33998105f, 0.33998105f, 0.8611363f);
 const GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX: vec4<f32> = vec4<f32>(0.34785485f, 0.65214515f, 0.65214515f, 0.34785485f);
 const CONE_FLOORX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX: f32 = 0.001f;
+const MOMENT_RANGE_FLOORX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX: f32 = 0.1f;
 const STRIDE: u32 = 1u;
 const REGIONS: u32 = 4u;
 const BASES_PER_THREAD: u32 = 6u;
@@ -182,11 +183,11 @@ fn spot_integrandX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye: vec3<f32>, dir: v
     let x_8 = (eye + (dir * t));
     let to_x = (x_8 - light_pos);
     let d2_ = max(dot(to_x, to_x), 0.000000000001f);
-    let d_1 = sqrt(d2_);
-    let travel = (to_x / vec3(d_1));
+    let d_2 = sqrt(d2_);
+    let travel = (to_x / vec3(d_2));
     let _e17 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(travel, light_dir), cos_inner_1, cos_outer_1);
     let _e22 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(medium.z, -(dot(travel, dir)));
-    return ((((medium.y * _e22) * _e17) * exp((-(medium.x) * (d_1 + t)))) / d2_);
+    return ((((medium.y * _e22) * _e17) * exp((-(medium.x) * (d_2 + t)))) / d2_);
 }
 
 fn spot_spanX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_1: vec3<f32>, dir_1: vec3<f32>, a_1: f32, b_1: f32, panels: u32, light_pos_1: vec3<f32>, light_dir_1: vec3<f32>, cos_inner_2: f32, cos_outer_2: f32, medium_1: vec4<f32>) -> f32 {
@@ -332,18 +333,18 @@ fn ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_6: FrameX_naga_oil_m
     }
 }
 
-fn texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_7: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, s_1: SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, e_1: vec3<f32>, i_1: u32, weighted: bool, spot_3: bool) -> f32 {
+fn texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_7: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, s_1: SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, e_1: vec3<f32>, i_2: u32, weighted: bool, spot_3: bool) -> f32 {
     var w: f32;
 
-    let _e5 = ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_7, s_1, f32(i_1), spot_3);
-    let _e9 = ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_7, s_1, f32((i_1 + 1u)), spot_3);
+    let _e5 = ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_7, s_1, f32(i_2), spot_3);
+    let _e9 = ref_tX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_7, s_1, f32((i_2 + 1u)), spot_3);
     if !(weighted) {
         return (_e9 - _e5);
     }
     let _e15 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_7.medium.x, _e5, _e9);
     w = _e15;
     if spot_3 {
-        let psi_1 = ((f32(i_1) + 0.5f) * s_1.delta);
+        let psi_1 = ((f32(i_2) + 0.5f) * s_1.delta);
         let l_1 = ((-(f_7.axis.xyz) * cos(psi_1)) + (e_1 * sin(psi_1)));
         let den_1 = max(sin((s_1.theta_ref + psi_1)), 0.0001f);
         let r_2 = max(((f_7.axis.w * sin(s_1.theta_ref)) / den_1), 0.0001f);
@@ -356,8 +357,8 @@ fn texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(f_7: FrameX_nag
     return _e64;
 }
 
-fn moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(d: f32) -> f32 {
-    return ((2f * d) - 1f);
+fn moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(d_1: f32, range: vec2<f32>) -> f32 {
+    return (((2f * d_1) - (range.x + range.y)) / max((range.y - range.x), MOMENT_RANGE_FLOORX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX));
 }
 
 fn moment_layerX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(z_1: f32, layer: u32) -> vec4<f32> {
@@ -403,105 +404,131 @@ fn prefilter(@builtin(global_invocation_id) id: vec3<u32>) {
     var wsum: f32 = 0f;
     var lo: f32 = 1000000000000000000000000000000f;
     var hi: f32 = -1000000000000000000000000000000f;
+    var depth_range: vec2<f32> = vec2<f32>(1000000000000000000000000000000f, -1000000000000000000000000000000f);
     var i: u32;
+    var d: f32;
+    var i_1: u32;
     var q: u32;
 
     let row_6 = id.x;
     let region = id.y;
     let thread = id.z;
     let width_2 = frame.sizes.z;
-    let _e14 = frame.sizes.w;
-    if !((row_6 >= _e14)) {
+    let _e15 = frame.sizes.w;
+    if !((row_6 >= _e15)) {
         local = (region >= REGIONS);
     } else {
         local = true;
     }
-    let _e22 = local;
-    if !(_e22) {
+    let _e23 = local;
+    if !(_e23) {
         local_1 = (thread >= THREADS_PER_ROW_REGION);
     } else {
         local_1 = true;
     }
-    let _e29 = local_1;
-    if _e29 {
+    let _e30 = local_1;
+    if _e30 {
         return;
     }
-    let _e32 = slices[row_6];
-    let _e33 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e32);
-    let _e35 = frame;
-    let _e37 = frame;
-    let _e38 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e37, row_6);
-    let _e39 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e35, _e38);
-    let _e43 = region_columnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(region, REGIONS, width_2, STRIDE, false);
-    let _e48 = region_columnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((region + 1u), REGIONS, width_2, STRIDE, false);
-    i = _e43;
+    let _e33 = slices[row_6];
+    let _e34 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e33);
+    let _e36 = frame;
+    let _e38 = frame;
+    let _e39 = row_phiX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e38, row_6);
+    let _e40 = slice_eX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e36, _e39);
+    let _e44 = region_columnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(region, REGIONS, width_2, STRIDE, false);
+    let _e49 = region_columnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((region + 1u), REGIONS, width_2, STRIDE, false);
+    i = _e44;
     loop {
-        let _e50 = i;
-        if (_e50 < _e48) {
+        let _e51 = i;
+        if (_e51 < _e49) {
         } else {
             break;
         }
         {
-            let _e52 = i;
-            let _e56 = textureLoad(rectified, vec2<u32>(_e52, row_6), 0i);
-            let d_2 = _e56.x;
-            let _e59 = frame;
-            let _e60 = i;
-            let _e62 = texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e59, _e33, _e39, _e60, true, false);
-            let _e64 = wsum;
-            wsum = (_e64 + _e62);
-            let _e66 = i;
-            let store = ((_e66 % STRIDE) == 0u);
+            let _e53 = i;
+            let _e57 = textureLoad(rectified, vec2<u32>(_e53, row_6), 0i);
+            d = _e57.x;
+            let _e62 = depth_range.x;
+            let _e63 = d;
+            let _e66 = depth_range.y;
+            let _e67 = d;
+            depth_range = vec2<f32>(min(_e62, _e63), max(_e66, _e67));
+        }
+        continuing {
             let _e71 = i;
-            let x_9 = (_e71 / STRIDE);
+            i = (_e71 + 1u);
+        }
+    }
+    i_1 = _e44;
+    loop {
+        let _e74 = i_1;
+        if (_e74 < _e49) {
+        } else {
+            break;
+        }
+        {
+            let _e76 = i_1;
+            let _e80 = textureLoad(rectified, vec2<u32>(_e76, row_6), 0i);
+            let d_3 = _e80.x;
+            let _e83 = frame;
+            let _e84 = i_1;
+            let _e86 = texel_weightX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e83, _e34, _e40, _e84, true, false);
+            let _e88 = wsum;
+            wsum = (_e88 + _e86);
+            let _e90 = i_1;
+            let store = ((_e90 % STRIDE) == 0u);
+            let _e95 = i_1;
+            let x_9 = (_e95 / STRIDE);
             if (thread == 0u) {
-                let _e77 = lo;
-                lo = min(_e77, d_2);
-                let _e80 = hi;
-                hi = max(_e80, d_2);
+                let _e101 = lo;
+                lo = min(_e101, d_3);
+                let _e104 = hi;
+                hi = max(_e104, d_3);
                 if store {
-                    let _e82 = bounds_index(x_9, row_6);
-                    let _e85 = lo;
-                    let _e86 = hi;
-                    bounds[_e82] = vec2<f32>(_e85, _e86);
+                    let _e106 = bounds_index(x_9, row_6);
+                    let _e109 = lo;
+                    let _e110 = hi;
+                    bounds[_e106] = vec2<f32>(_e109, _e110);
                 }
             }
-            let _e88 = wsum;
-            let _e90 = wsum;
-            let blend = select(0f, (_e62 / _e88), (_e90 > 0f));
-            let _e95 = moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(d_2);
+            let _e112 = wsum;
+            let _e114 = wsum;
+            let blend = select(0f, (_e86 / _e112), (_e114 > 0f));
+            let _e119 = depth_range;
+            let _e120 = moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(d_3, _e119);
             q = 0u;
             loop {
-                let _e99 = q;
-                if (_e99 < 2u) {
+                let _e124 = q;
+                if (_e124 < 2u) {
                 } else {
                     break;
                 }
                 {
-                    let _e102 = q;
-                    let _e104 = q;
-                    let _e106 = acc[_e104];
-                    let _e110 = q;
-                    let _e111 = moment_layerX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(_e95, _e110);
-                    acc[_e102] = ((_e106 * (1f - blend)) + (_e111 * blend));
+                    let _e127 = q;
+                    let _e129 = q;
+                    let _e131 = acc[_e129];
+                    let _e135 = q;
+                    let _e136 = moment_layerX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(_e120, _e135);
+                    acc[_e127] = ((_e131 * (1f - blend)) + (_e136 * blend));
                     if store {
-                        let _e114 = q;
-                        let _e115 = filtered_index(x_9, row_6, _e114);
-                        let _e118 = q;
-                        let _e120 = acc[_e118];
-                        let _e121 = encode_layer(_e120);
-                        filtered[_e115] = _e121;
+                        let _e139 = q;
+                        let _e140 = filtered_index(x_9, row_6, _e139);
+                        let _e143 = q;
+                        let _e145 = acc[_e143];
+                        let _e146 = encode_layer(_e145);
+                        filtered[_e140] = _e146;
                     }
                 }
                 continuing {
-                    let _e123 = q;
-                    q = (_e123 + 1u);
+                    let _e148 = q;
+                    q = (_e148 + 1u);
                 }
             }
         }
         continuing {
-            let _e126 = i;
-            i = (_e126 + 1u);
+            let _e151 = i_1;
+            i_1 = (_e151 + 1u);
         }
     }
     return;

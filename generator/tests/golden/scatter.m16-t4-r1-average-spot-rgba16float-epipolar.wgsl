@@ -513,147 +513,147 @@ fn scatter_pixel(x_6: u32, y_1: u32) -> vec3<f32> {
     let width_1 = (f_12.sizes.z / STRIDE);
     let wrap_1 = (f_12.anti_epipole.w > 0.5f);
     {
-        theta_3 = acos(clamp(dot(_e10, axis), -1f, 1f));
-        let _e61 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, _e10);
-        yc = _e61;
-        let _e63 = theta_3;
-        let _e68 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e63, f_12.theta.x, f_12.theta.y);
-        d = _e68;
-        let _e70 = theta_3;
-        let _e71 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, _e10, s_3, _e70, true);
-        reach = _e71;
+        theta_3 = atan2(length(cross(_e10, axis)), dot(_e10, axis));
+        let _e60 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, _e10);
+        yc = _e60;
+        let _e62 = theta_3;
+        let _e67 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e62, f_12.theta.x, f_12.theta.y);
+        d = _e67;
+        let _e69 = theta_3;
+        let _e70 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, _e10, s_3, _e69, true);
+        reach = _e70;
     }
-    let _e73 = yc;
-    let yb = (_e73 - 0.5f);
+    let _e72 = yc;
+    let yb = (_e72 - 0.5f);
     let fy = (yb - floor(yb));
-    let _e79 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(yb), rows_2, wrap_1);
-    let _e83 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX((floor(yb) + 1f), rows_2, wrap_1);
-    let row1_ = select(_e79, _e83, (yb > floor(yb)));
-    let w1_ = select(0f, fy, (row1_ != _e79));
+    let _e78 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(yb), rows_2, wrap_1);
+    let _e82 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX((floor(yb) + 1f), rows_2, wrap_1);
+    let row1_ = select(_e78, _e82, (yb > floor(yb)));
+    let w1_ = select(0f, fy, (row1_ != _e78));
     let cos_theta_l = -(dot(f_12.light_dir.xyz, _e10));
     let panels_2 = max((f_12.sizes2_.z / 4u), 1u);
-    let _e101 = d;
-    let _e105 = d;
-    angle = vec2<f32>(sin((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e101)), cos((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e105)));
-    let _e110 = angle;
-    let _e111 = fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e110);
+    let _e100 = d;
+    let _e104 = d;
+    angle = vec2<f32>(sin((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e100)), cos((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e104)));
+    let _e109 = angle;
+    let _e110 = fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e109);
     loop {
-        let _e113 = layer_3;
-        if (_e113 < LAYERS) {
+        let _e112 = layer_3;
+        if (_e112 < LAYERS) {
         } else {
             break;
         }
         {
-            let _e116 = angle;
-            let _e117 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e116, _e111);
-            let _e119 = layer_3;
-            let _e121 = angle;
-            let _e122 = layer_3;
-            let _e123 = coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e121, _e117, _e122);
-            coeffs[_e119] = _e123;
-            let _e124 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e117, _e111);
-            angle = _e124;
+            let _e115 = angle;
+            let _e116 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e115, _e110);
+            let _e118 = layer_3;
+            let _e120 = angle;
+            let _e121 = layer_3;
+            let _e122 = coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e120, _e116, _e121);
+            coeffs[_e118] = _e122;
+            let _e123 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e116, _e110);
+            angle = _e123;
         }
         continuing {
-            let _e126 = layer_3;
-            layer_3 = (_e126 + 1u);
+            let _e125 = layer_3;
+            layer_3 = (_e125 + 1u);
         }
     }
-    let _e132 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.z, cos_theta_l);
-    let sun_scatter = (f_12.medium.y * _e132);
-    let _e135 = xs;
-    xs0_ = _e135;
-    let _e137 = xs;
-    xs1_ = _e137;
+    let _e131 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.z, cos_theta_l);
+    let sun_scatter = (f_12.medium.y * _e131);
+    let _e134 = xs;
+    xs0_ = _e134;
+    let _e136 = xs;
+    xs1_ = _e136;
     {
-        let _e141 = slices[_e79];
-        let _e142 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e141);
-        delta0_ = (1f * _e142.delta);
-        let _e149 = slices[row1_];
-        let _e150 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e149);
-        delta1_ = (1f * _e150.delta);
-        let _e155 = reach;
-        let _e156 = delta0_;
-        xs0_ = (_e155 / _e156);
-        let _e158 = reach;
-        let _e159 = delta1_;
-        xs1_ = (_e158 / _e159);
+        let _e140 = slices[_e78];
+        let _e141 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e140);
+        delta0_ = (1f * _e141.delta);
+        let _e148 = slices[row1_];
+        let _e149 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e148);
+        delta1_ = (1f * _e149.delta);
+        let _e154 = reach;
+        let _e155 = delta0_;
+        xs0_ = (_e154 / _e155);
+        let _e157 = reach;
+        let _e158 = delta1_;
+        xs1_ = (_e157 / _e158);
     }
-    let _e161 = xs0_;
-    let last0_ = u32(min(max(_e161, 0f), (f32(width_1) - 1f)));
-    let _e169 = xs1_;
-    let last1_ = u32(min(max(_e169, 0f), (f32(width_1) - 1f)));
+    let _e160 = xs0_;
+    let last0_ = u32(min(max(_e160, 0f), (f32(width_1) - 1f)));
+    let _e168 = xs1_;
+    let last1_ = u32(min(max(_e168, 0f), (f32(width_1) - 1f)));
     loop {
-        let _e179 = r_1;
-        if (_e179 < REGIONS) {
+        let _e178 = r_1;
+        if (_e178 < REGIONS) {
         } else {
             break;
         }
         {
-            let _e181 = r_1;
-            let _e182 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e181, REGIONS, width_1, true);
-            let b0_ = f32(_e182);
-            let _e184 = r_1;
-            let _e187 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e184 + 1u), REGIONS, width_1, true);
-            let b1_ = f32(_e187);
+            let _e180 = r_1;
+            let _e181 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e180, REGIONS, width_1, true);
+            let b0_ = f32(_e181);
+            let _e183 = r_1;
+            let _e186 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e183 + 1u), REGIONS, width_1, true);
+            let b1_ = f32(_e186);
             if !((last0_ < u32(b1_))) {
-                let _e192 = r_1;
-                local_2 = ((_e192 + 1u) == REGIONS);
+                let _e191 = r_1;
+                local_2 = ((_e191 + 1u) == REGIONS);
             } else {
                 local_2 = true;
             }
             let is_last0_ = local_2;
             if !((last1_ < u32(b1_))) {
-                let _e203 = r_1;
-                local_3 = ((_e203 + 1u) == REGIONS);
+                let _e202 = r_1;
+                local_3 = ((_e202 + 1u) == REGIONS);
             } else {
                 local_3 = true;
             }
             let is_last1_ = local_3;
-            let _e213 = xs0_;
-            let pos0_ = select((b1_ - 0.5f), clamp((_e213 - 0.5f), (b0_ + 0.5f), (b1_ - 0.5f)), is_last0_);
-            let _e224 = xs1_;
-            let pos1_ = select((b1_ - 0.5f), clamp((_e224 - 0.5f), (b0_ + 0.5f), (b1_ - 0.5f)), is_last1_);
+            let _e212 = xs0_;
+            let pos0_ = select((b1_ - 0.5f), clamp((_e212 - 0.5f), (b0_ + 0.5f), (b1_ - 0.5f)), is_last0_);
+            let _e223 = xs1_;
+            let pos1_ = select((b1_ - 0.5f), clamp((_e223 - 0.5f), (b0_ + 0.5f), (b1_ - 0.5f)), is_last1_);
             a0_ = f32();
             e0_ = f32();
             a1_ = f32();
             e1_ = f32();
-            let _e241 = delta0_;
-            let _e242 = theta_3;
-            let _e243 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b0_, _e241, _e242, s_3, true);
-            a0_ = _e243;
-            let _e244 = delta0_;
-            let _e245 = theta_3;
-            let _e246 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b1_, _e244, _e245, s_3, true);
-            e0_ = select(_e246, s_3, is_last0_);
-            let _e248 = delta1_;
-            let _e249 = theta_3;
-            let _e250 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b0_, _e248, _e249, s_3, true);
-            a1_ = _e250;
-            let _e251 = delta1_;
-            let _e252 = theta_3;
-            let _e253 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b1_, _e251, _e252, s_3, true);
-            e1_ = select(_e253, s_3, is_last1_);
+            let _e240 = delta0_;
+            let _e241 = theta_3;
+            let _e242 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b0_, _e240, _e241, s_3, true);
+            a0_ = _e242;
+            let _e243 = delta0_;
+            let _e244 = theta_3;
+            let _e245 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b1_, _e243, _e244, s_3, true);
+            e0_ = select(_e245, s_3, is_last0_);
+            let _e247 = delta1_;
+            let _e248 = theta_3;
+            let _e249 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b0_, _e247, _e248, s_3, true);
+            a1_ = _e249;
+            let _e250 = delta1_;
+            let _e251 = theta_3;
+            let _e252 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b1_, _e250, _e251, s_3, true);
+            e1_ = select(_e252, s_3, is_last1_);
             weight0_ = f32();
             weight1_ = f32();
             if true {
-                let _e259 = a0_;
-                let _e260 = e0_;
-                let _e261 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, _e10, _e259, _e260, panels_2);
-                weight0_ = _e261;
-                let _e262 = a1_;
-                let _e263 = e1_;
-                let _e264 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, _e10, _e262, _e263, panels_2);
-                weight1_ = _e264;
+                let _e258 = a0_;
+                let _e259 = e0_;
+                let _e260 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, _e10, _e258, _e259, panels_2);
+                weight0_ = _e260;
+                let _e261 = a1_;
+                let _e262 = e1_;
+                let _e263 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, _e10, _e261, _e262, panels_2);
+                weight1_ = _e263;
             } else {
-                let _e267 = a0_;
-                let _e268 = e0_;
-                let _e269 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.x, _e267, _e268);
-                weight0_ = (sun_scatter * _e269);
-                let _e273 = a1_;
-                let _e274 = e1_;
-                let _e275 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.x, _e273, _e274);
-                weight1_ = (sun_scatter * _e275);
+                let _e266 = a0_;
+                let _e267 = e0_;
+                let _e268 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.x, _e266, _e267);
+                weight0_ = (sun_scatter * _e268);
+                let _e272 = a1_;
+                let _e273 = e1_;
+                let _e274 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.x, _e272, _e273);
+                weight1_ = (sun_scatter * _e274);
             }
             let xb0_ = (pos0_ - 0.5f);
             let fx0_ = (xb0_ - floor(xb0_));
@@ -663,142 +663,142 @@ fn scatter_pixel(x_6: u32, y_1: u32) -> vec3<f32> {
             let fx1_ = (xb1_ - floor(xb1_));
             let x10_ = u32(clamp(floor(xb1_), 0f, (f32(width_1) - 1f)));
             let x11_ = select(x10_, min((x10_ + 1u), (width_1 - 1u)), (xb1_ > floor(xb1_)));
-            let _e315 = bounds_index(x01_, _e79);
-            let lohi0_ = bounds[_e315];
-            let _e319 = bounds_index(x11_, row1_);
-            let lohi1_ = bounds[_e319];
+            let _e314 = bounds_index(x01_, _e78);
+            let lohi0_ = bounds[_e314];
+            let _e318 = bounds_index(x11_, row1_);
+            let lohi1_ = bounds[_e318];
             vis0_ = 0.5f;
             vis1_ = 0.5f;
-            let _e327 = d;
-            if (_e327 > lohi0_.x) {
-                let _e330 = d;
-                local_4 = (_e330 <= lohi0_.y);
+            let _e326 = d;
+            if (_e326 > lohi0_.x) {
+                let _e329 = d;
+                local_4 = (_e329 <= lohi0_.y);
             } else {
                 local_4 = false;
             }
-            let _e336 = local_4;
-            if !(_e336) {
-                let _e338 = d;
-                if (_e338 > lohi1_.x) {
-                    let _e341 = d;
-                    local_6 = (_e341 <= lohi1_.y);
+            let _e335 = local_4;
+            if !(_e335) {
+                let _e337 = d;
+                if (_e337 > lohi1_.x) {
+                    let _e340 = d;
+                    local_6 = (_e340 <= lohi1_.y);
                 } else {
                     local_6 = false;
                 }
-                let _e347 = local_6;
-                local_5 = _e347;
+                let _e346 = local_6;
+                local_5 = _e346;
             } else {
                 local_5 = true;
             }
-            let _e351 = local_5;
-            if _e351 {
+            let _e350 = local_5;
+            if _e350 {
                 layer_4 = 0u;
                 loop {
-                    let _e354 = layer_4;
-                    if (_e354 < LAYERS) {
+                    let _e353 = layer_4;
+                    if (_e353 < LAYERS) {
                     } else {
                         break;
                     }
                     {
-                        let _e357 = layer_4;
-                        let coeff = coeffs[_e357];
-                        let _e360 = layer_4;
-                        let _e361 = filtered_load(x00_, _e79, _e360);
-                        let _e362 = layer_4;
-                        let _e363 = filtered_load(x01_, _e79, _e362);
-                        let texel0_ = mix(_e361, _e363, fx0_);
-                        let _e365 = layer_4;
-                        let _e366 = filtered_load(x10_, row1_, _e365);
-                        let _e367 = layer_4;
-                        let _e368 = filtered_load(x11_, row1_, _e367);
-                        let texel1_ = mix(_e366, _e368, fx1_);
+                        let _e356 = layer_4;
+                        let coeff = coeffs[_e356];
+                        let _e359 = layer_4;
+                        let _e360 = filtered_load(x00_, _e78, _e359);
+                        let _e361 = layer_4;
+                        let _e362 = filtered_load(x01_, _e78, _e361);
+                        let texel0_ = mix(_e360, _e362, fx0_);
+                        let _e364 = layer_4;
+                        let _e365 = filtered_load(x10_, row1_, _e364);
+                        let _e366 = layer_4;
+                        let _e367 = filtered_load(x11_, row1_, _e366);
+                        let texel1_ = mix(_e365, _e367, fx1_);
                         k_3 = 0u;
                         loop {
-                            let _e372 = k_3;
-                            if (_e372 < 4u) {
+                            let _e371 = k_3;
+                            if (_e371 < 4u) {
                             } else {
                                 break;
                             }
                             {
-                                let _e375 = vis0_;
-                                let _e376 = k_3;
-                                let _e378 = k_3;
-                                vis0_ = (_e375 + (coeff[_e376] * ((texel0_[_e378] * 2f) - 1f)));
-                                let _e386 = vis1_;
-                                let _e387 = k_3;
-                                let _e389 = k_3;
-                                vis1_ = (_e386 + (coeff[_e387] * ((texel1_[_e389] * 2f) - 1f)));
+                                let _e374 = vis0_;
+                                let _e375 = k_3;
+                                let _e377 = k_3;
+                                vis0_ = (_e374 + (coeff[_e375] * ((texel0_[_e377] * 2f) - 1f)));
+                                let _e385 = vis1_;
+                                let _e386 = k_3;
+                                let _e388 = k_3;
+                                vis1_ = (_e385 + (coeff[_e386] * ((texel1_[_e388] * 2f) - 1f)));
                             }
                             continuing {
-                                let _e398 = k_3;
-                                k_3 = (_e398 + 1u);
+                                let _e397 = k_3;
+                                k_3 = (_e397 + 1u);
                             }
                         }
                     }
                     continuing {
-                        let _e401 = layer_4;
-                        layer_4 = (_e401 + 1u);
+                        let _e400 = layer_4;
+                        layer_4 = (_e400 + 1u);
                     }
                 }
             }
-            let _e403 = vis0_;
-            let _e404 = d;
-            let _e409 = d;
-            vis0_ = select(select(_e403, 0f, (_e404 > lohi0_.y)), 1f, (_e409 <= lohi0_.x));
-            let _e414 = vis1_;
-            let _e415 = d;
-            let _e420 = d;
-            vis1_ = select(select(_e414, 0f, (_e415 > lohi1_.y)), 1f, (_e420 <= lohi1_.x));
-            let _e426 = done0_;
-            if !(_e426) {
-                let _e429 = total0_;
-                let _e430 = weight0_;
-                let _e431 = vis0_;
-                total0_ = (_e429 + (_e430 * clamp(_e431, 0f, 1f)));
+            let _e402 = vis0_;
+            let _e403 = d;
+            let _e408 = d;
+            vis0_ = select(select(_e402, 0f, (_e403 > lohi0_.y)), 1f, (_e408 <= lohi0_.x));
+            let _e413 = vis1_;
+            let _e414 = d;
+            let _e419 = d;
+            vis1_ = select(select(_e413, 0f, (_e414 > lohi1_.y)), 1f, (_e419 <= lohi1_.x));
+            let _e425 = done0_;
+            if !(_e425) {
+                let _e428 = total0_;
+                let _e429 = weight0_;
+                let _e430 = vis0_;
+                total0_ = (_e428 + (_e429 * clamp(_e430, 0f, 1f)));
             }
-            let _e438 = done1_;
-            if !(_e438) {
-                let _e441 = total1_;
-                let _e442 = weight1_;
-                let _e443 = vis1_;
-                total1_ = (_e441 + (_e442 * clamp(_e443, 0f, 1f)));
+            let _e437 = done1_;
+            if !(_e437) {
+                let _e440 = total1_;
+                let _e441 = weight1_;
+                let _e442 = vis1_;
+                total1_ = (_e440 + (_e441 * clamp(_e442, 0f, 1f)));
             }
-            let _e449 = done0_;
-            if !(_e449) {
+            let _e448 = done0_;
+            if !(_e448) {
                 local_7 = is_last0_;
             } else {
                 local_7 = true;
             }
-            let _e454 = local_7;
-            done0_ = _e454;
-            let _e455 = done1_;
-            if !(_e455) {
+            let _e453 = local_7;
+            done0_ = _e453;
+            let _e454 = done1_;
+            if !(_e454) {
                 local_8 = is_last1_;
             } else {
                 local_8 = true;
             }
-            let _e460 = local_8;
-            done1_ = _e460;
-            let _e461 = done0_;
-            if _e461 {
-                let _e462 = done1_;
-                local_9 = _e462;
+            let _e459 = local_8;
+            done1_ = _e459;
+            let _e460 = done0_;
+            if _e460 {
+                let _e461 = done1_;
+                local_9 = _e461;
             } else {
                 local_9 = false;
             }
-            let _e466 = local_9;
-            if _e466 {
+            let _e465 = local_9;
+            if _e465 {
                 break;
             }
         }
         continuing {
-            let _e468 = r_1;
-            r_1 = (_e468 + 1u);
+            let _e467 = r_1;
+            r_1 = (_e467 + 1u);
         }
     }
-    let _e472 = total0_;
-    let _e474 = total1_;
-    let l_2 = (((1f - w1_) * _e472) + (w1_ * _e474));
+    let _e471 = total0_;
+    let _e473 = total1_;
+    let l_2 = (((1f - w1_) * _e471) + (w1_ * _e473));
     let c = (color * l_2);
     return c;
 }

@@ -518,155 +518,155 @@ vec3 scatter_pixel(uint x_6, uint y_1) {
     uint width_1 = (f_12.sizes.z / STRIDE);
     bool wrap_1 = (f_12.anti_epipole.w > 0.5);
     {
-        theta_3 = acos(clamp(dot(_e10, axis), -1.0, 1.0));
-        float _e61 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, _e10);
-        yc = _e61;
-        float _e63 = theta_3;
-        float _e68 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e63, f_12.theta.x, f_12.theta.y);
-        d = _e68;
-        float _e70 = theta_3;
-        float _e71 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, _e10, s_3, _e70, false);
-        reach = _e71;
+        theta_3 = atan(length(cross(_e10, axis)), dot(_e10, axis));
+        float _e60 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, _e10);
+        yc = _e60;
+        float _e62 = theta_3;
+        float _e67 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e62, f_12.theta.x, f_12.theta.y);
+        d = _e67;
+        float _e69 = theta_3;
+        float _e70 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, _e10, s_3, _e69, false);
+        reach = _e70;
     }
-    float _e73 = yc;
-    float yb = (_e73 - 0.5);
+    float _e72 = yc;
+    float yb = (_e72 - 0.5);
     float fy = (yb - floor(yb));
-    uint _e79 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(yb), rows_2, wrap_1);
-    uint _e83 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX((floor(yb) + 1.0), rows_2, wrap_1);
-    uint row1_ = ((yb > floor(yb)) ? _e83 : _e79);
-    float w1_ = ((row1_ != _e79) ? fy : 0.0);
+    uint _e78 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(yb), rows_2, wrap_1);
+    uint _e82 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX((floor(yb) + 1.0), rows_2, wrap_1);
+    uint row1_ = ((yb > floor(yb)) ? _e82 : _e78);
+    float w1_ = ((row1_ != _e78) ? fy : 0.0);
     float cos_theta_l = -(dot(f_12.light_dir.xyz, _e10));
     uint panels_2 = max((f_12.sizes2_.z / 4u), 1u);
-    float _e101 = d;
-    float _e105 = d;
-    angle = vec2(sin((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e101)), cos((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e105)));
-    vec2 _e110 = angle;
-    vec2 _e111 = fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e110);
+    float _e100 = d;
+    float _e104 = d;
+    angle = vec2(sin((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e100)), cos((PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX * _e104)));
+    vec2 _e109 = angle;
+    vec2 _e110 = fourier_stepX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e109);
     bool loop_init_3 = true;
     while(true) {
         if (!loop_init_3) {
-            uint _e126 = layer_3;
-            layer_3 = (_e126 + 1u);
+            uint _e125 = layer_3;
+            layer_3 = (_e125 + 1u);
         }
         loop_init_3 = false;
-        uint _e113 = layer_3;
-        if ((_e113 < LAYERS)) {
+        uint _e112 = layer_3;
+        if ((_e112 < LAYERS)) {
         } else {
             break;
         }
         {
-            vec2 _e116 = angle;
-            vec2 _e117 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e116, _e111);
-            uint _e119 = layer_3;
-            vec2 _e121 = angle;
-            uint _e122 = layer_3;
-            vec4 _e123 = coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e121, _e117, _e122);
-            coeffs[_e119] = _e123;
-            vec2 _e124 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e117, _e111);
-            angle = _e124;
+            vec2 _e115 = angle;
+            vec2 _e116 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e115, _e110);
+            uint _e118 = layer_3;
+            vec2 _e120 = angle;
+            uint _e121 = layer_3;
+            vec4 _e122 = coeff4X_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e120, _e116, _e121);
+            coeffs[_e118] = _e122;
+            vec2 _e123 = turnX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e116, _e110);
+            angle = _e123;
         }
     }
-    float _e132 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.z, cos_theta_l);
-    float sun_scatter = (f_12.medium.y * _e132);
-    float _e135 = xs;
-    xs0_ = _e135;
-    float _e137 = xs;
-    xs1_ = _e137;
+    float _e131 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.z, cos_theta_l);
+    float sun_scatter = (f_12.medium.y * _e131);
+    float _e134 = xs;
+    xs0_ = _e134;
+    float _e136 = xs;
+    xs1_ = _e136;
     {
-        vec4 _e141 = _group_0_binding_1_cs[_e79];
-        SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e142 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e141);
-        delta0_ = (1.0 * _e142.delta);
-        vec4 _e149 = _group_0_binding_1_cs[row1_];
-        SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e150 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e149);
-        delta1_ = (1.0 * _e150.delta);
-        float _e155 = reach;
-        float _e156 = delta0_;
-        xs0_ = (_e155 / _e156);
-        float _e158 = reach;
-        float _e159 = delta1_;
-        xs1_ = (_e158 / _e159);
+        vec4 _e140 = _group_0_binding_1_cs[_e78];
+        SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e141 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e140);
+        delta0_ = (1.0 * _e141.delta);
+        vec4 _e148 = _group_0_binding_1_cs[row1_];
+        SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e149 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e148);
+        delta1_ = (1.0 * _e149.delta);
+        float _e154 = reach;
+        float _e155 = delta0_;
+        xs0_ = (_e154 / _e155);
+        float _e157 = reach;
+        float _e158 = delta1_;
+        xs1_ = (_e157 / _e158);
     }
-    float _e161 = xs0_;
-    uint last0_ = uint(min(max(_e161, 0.0), (float(width_1) - 1.0)));
-    float _e169 = xs1_;
-    uint last1_ = uint(min(max(_e169, 0.0), (float(width_1) - 1.0)));
+    float _e160 = xs0_;
+    uint last0_ = uint(min(max(_e160, 0.0), (float(width_1) - 1.0)));
+    float _e168 = xs1_;
+    uint last1_ = uint(min(max(_e168, 0.0), (float(width_1) - 1.0)));
     bool loop_init_4 = true;
     while(true) {
         if (!loop_init_4) {
-            uint _e468 = r_1;
-            r_1 = (_e468 + 1u);
+            uint _e467 = r_1;
+            r_1 = (_e467 + 1u);
         }
         loop_init_4 = false;
-        uint _e179 = r_1;
-        if ((_e179 < REGIONS)) {
+        uint _e178 = r_1;
+        if ((_e178 < REGIONS)) {
         } else {
             break;
         }
         {
-            uint _e181 = r_1;
-            uint _e182 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e181, REGIONS, width_1, false);
-            float b0_ = float(_e182);
-            uint _e184 = r_1;
-            uint _e187 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e184 + 1u), REGIONS, width_1, false);
-            float b1_ = float(_e187);
+            uint _e180 = r_1;
+            uint _e181 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e180, REGIONS, width_1, false);
+            float b0_ = float(_e181);
+            uint _e183 = r_1;
+            uint _e186 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e183 + 1u), REGIONS, width_1, false);
+            float b1_ = float(_e186);
             if (!((last0_ < uint(b1_)))) {
-                uint _e192 = r_1;
-                local_2 = ((_e192 + 1u) == REGIONS);
+                uint _e191 = r_1;
+                local_2 = ((_e191 + 1u) == REGIONS);
             } else {
                 local_2 = true;
             }
             bool is_last0_ = local_2;
             if (!((last1_ < uint(b1_)))) {
-                uint _e203 = r_1;
-                local_3 = ((_e203 + 1u) == REGIONS);
+                uint _e202 = r_1;
+                local_3 = ((_e202 + 1u) == REGIONS);
             } else {
                 local_3 = true;
             }
             bool is_last1_ = local_3;
-            float _e213 = xs0_;
-            float pos0_ = (is_last0_ ? clamp((_e213 - 0.5), (b0_ + 0.5), (b1_ - 0.5)) : (b1_ - 0.5));
-            float _e224 = xs1_;
-            float pos1_ = (is_last1_ ? clamp((_e224 - 0.5), (b0_ + 0.5), (b1_ - 0.5)) : (b1_ - 0.5));
+            float _e212 = xs0_;
+            float pos0_ = (is_last0_ ? clamp((_e212 - 0.5), (b0_ + 0.5), (b1_ - 0.5)) : (b1_ - 0.5));
+            float _e223 = xs1_;
+            float pos1_ = (is_last1_ ? clamp((_e223 - 0.5), (b0_ + 0.5), (b1_ - 0.5)) : (b1_ - 0.5));
             a0_ = 0.0;
             e0_ = 0.0;
             a1_ = 0.0;
             e1_ = 0.0;
-            float _e241 = delta0_;
-            float _e242 = theta_3;
-            float _e243 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b0_, _e241, _e242, s_3, false);
-            a0_ = _e243;
-            float _e244 = delta0_;
-            float _e245 = theta_3;
-            float _e246 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b1_, _e244, _e245, s_3, false);
-            e0_ = (is_last0_ ? s_3 : _e246);
-            float _e248 = delta1_;
-            float _e249 = theta_3;
-            float _e250 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b0_, _e248, _e249, s_3, false);
-            a1_ = _e250;
-            float _e251 = delta1_;
-            float _e252 = theta_3;
-            float _e253 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b1_, _e251, _e252, s_3, false);
-            e1_ = (is_last1_ ? s_3 : _e253);
+            float _e240 = delta0_;
+            float _e241 = theta_3;
+            float _e242 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b0_, _e240, _e241, s_3, false);
+            a0_ = _e242;
+            float _e243 = delta0_;
+            float _e244 = theta_3;
+            float _e245 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b1_, _e243, _e244, s_3, false);
+            e0_ = (is_last0_ ? s_3 : _e245);
+            float _e247 = delta1_;
+            float _e248 = theta_3;
+            float _e249 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b0_, _e247, _e248, s_3, false);
+            a1_ = _e249;
+            float _e250 = delta1_;
+            float _e251 = theta_3;
+            float _e252 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b1_, _e250, _e251, s_3, false);
+            e1_ = (is_last1_ ? s_3 : _e252);
             weight0_ = 0.0;
             weight1_ = 0.0;
             if (false) {
-                float _e259 = a0_;
-                float _e260 = e0_;
-                float _e261 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, _e10, _e259, _e260, panels_2);
-                weight0_ = _e261;
-                float _e262 = a1_;
-                float _e263 = e1_;
-                float _e264 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, _e10, _e262, _e263, panels_2);
-                weight1_ = _e264;
+                float _e258 = a0_;
+                float _e259 = e0_;
+                float _e260 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, _e10, _e258, _e259, panels_2);
+                weight0_ = _e260;
+                float _e261 = a1_;
+                float _e262 = e1_;
+                float _e263 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, _e10, _e261, _e262, panels_2);
+                weight1_ = _e263;
             } else {
-                float _e267 = a0_;
-                float _e268 = e0_;
-                float _e269 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.x, _e267, _e268);
-                weight0_ = (sun_scatter * _e269);
-                float _e273 = a1_;
-                float _e274 = e1_;
-                float _e275 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.x, _e273, _e274);
-                weight1_ = (sun_scatter * _e275);
+                float _e266 = a0_;
+                float _e267 = e0_;
+                float _e268 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.x, _e266, _e267);
+                weight0_ = (sun_scatter * _e268);
+                float _e272 = a1_;
+                float _e273 = e1_;
+                float _e274 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.x, _e272, _e273);
+                weight1_ = (sun_scatter * _e274);
             }
             float xb0_ = (pos0_ - 0.5);
             float fx0_ = (xb0_ - floor(xb0_));
@@ -676,142 +676,142 @@ vec3 scatter_pixel(uint x_6, uint y_1) {
             float fx1_ = (xb1_ - floor(xb1_));
             uint x10_ = uint(clamp(floor(xb1_), 0.0, (float(width_1) - 1.0)));
             uint x11_ = ((xb1_ > floor(xb1_)) ? min((x10_ + 1u), (width_1 - 1u)) : x10_);
-            uint _e315 = bounds_index(x01_, _e79);
-            vec2 lohi0_ = _group_0_binding_6_cs[_e315];
-            uint _e319 = bounds_index(x11_, row1_);
-            vec2 lohi1_ = _group_0_binding_6_cs[_e319];
+            uint _e314 = bounds_index(x01_, _e78);
+            vec2 lohi0_ = _group_0_binding_6_cs[_e314];
+            uint _e318 = bounds_index(x11_, row1_);
+            vec2 lohi1_ = _group_0_binding_6_cs[_e318];
             vis0_ = 0.5;
             vis1_ = 0.5;
-            float _e327 = d;
-            if ((_e327 > lohi0_.x)) {
-                float _e330 = d;
-                local_4 = (_e330 <= lohi0_.y);
+            float _e326 = d;
+            if ((_e326 > lohi0_.x)) {
+                float _e329 = d;
+                local_4 = (_e329 <= lohi0_.y);
             } else {
                 local_4 = false;
             }
-            bool _e336 = local_4;
-            if (!(_e336)) {
-                float _e338 = d;
-                if ((_e338 > lohi1_.x)) {
-                    float _e341 = d;
-                    local_6 = (_e341 <= lohi1_.y);
+            bool _e335 = local_4;
+            if (!(_e335)) {
+                float _e337 = d;
+                if ((_e337 > lohi1_.x)) {
+                    float _e340 = d;
+                    local_6 = (_e340 <= lohi1_.y);
                 } else {
                     local_6 = false;
                 }
-                bool _e347 = local_6;
-                local_5 = _e347;
+                bool _e346 = local_6;
+                local_5 = _e346;
             } else {
                 local_5 = true;
             }
-            bool _e351 = local_5;
-            if (_e351) {
+            bool _e350 = local_5;
+            if (_e350) {
                 layer_4 = 0u;
                 bool loop_init_5 = true;
                 while(true) {
                     if (!loop_init_5) {
-                        uint _e401 = layer_4;
-                        layer_4 = (_e401 + 1u);
+                        uint _e400 = layer_4;
+                        layer_4 = (_e400 + 1u);
                     }
                     loop_init_5 = false;
-                    uint _e354 = layer_4;
-                    if ((_e354 < LAYERS)) {
+                    uint _e353 = layer_4;
+                    if ((_e353 < LAYERS)) {
                     } else {
                         break;
                     }
                     {
-                        uint _e357 = layer_4;
-                        vec4 coeff = coeffs[_e357];
-                        uint _e360 = layer_4;
-                        vec4 _e361 = filtered_load(x00_, _e79, _e360);
-                        uint _e362 = layer_4;
-                        vec4 _e363 = filtered_load(x01_, _e79, _e362);
-                        vec4 texel0_ = mix(_e361, _e363, fx0_);
-                        uint _e365 = layer_4;
-                        vec4 _e366 = filtered_load(x10_, row1_, _e365);
-                        uint _e367 = layer_4;
-                        vec4 _e368 = filtered_load(x11_, row1_, _e367);
-                        vec4 texel1_ = mix(_e366, _e368, fx1_);
+                        uint _e356 = layer_4;
+                        vec4 coeff = coeffs[_e356];
+                        uint _e359 = layer_4;
+                        vec4 _e360 = filtered_load(x00_, _e78, _e359);
+                        uint _e361 = layer_4;
+                        vec4 _e362 = filtered_load(x01_, _e78, _e361);
+                        vec4 texel0_ = mix(_e360, _e362, fx0_);
+                        uint _e364 = layer_4;
+                        vec4 _e365 = filtered_load(x10_, row1_, _e364);
+                        uint _e366 = layer_4;
+                        vec4 _e367 = filtered_load(x11_, row1_, _e366);
+                        vec4 texel1_ = mix(_e365, _e367, fx1_);
                         k_3 = 0u;
                         bool loop_init_6 = true;
                         while(true) {
                             if (!loop_init_6) {
-                                uint _e398 = k_3;
-                                k_3 = (_e398 + 1u);
+                                uint _e397 = k_3;
+                                k_3 = (_e397 + 1u);
                             }
                             loop_init_6 = false;
-                            uint _e372 = k_3;
-                            if ((_e372 < 4u)) {
+                            uint _e371 = k_3;
+                            if ((_e371 < 4u)) {
                             } else {
                                 break;
                             }
                             {
-                                float _e375 = vis0_;
-                                uint _e376 = k_3;
-                                uint _e378 = k_3;
-                                vis0_ = (_e375 + (coeff[_e376] * ((texel0_[_e378] * 2.0) - 1.0)));
-                                float _e386 = vis1_;
-                                uint _e387 = k_3;
-                                uint _e389 = k_3;
-                                vis1_ = (_e386 + (coeff[_e387] * ((texel1_[_e389] * 2.0) - 1.0)));
+                                float _e374 = vis0_;
+                                uint _e375 = k_3;
+                                uint _e377 = k_3;
+                                vis0_ = (_e374 + (coeff[_e375] * ((texel0_[_e377] * 2.0) - 1.0)));
+                                float _e385 = vis1_;
+                                uint _e386 = k_3;
+                                uint _e388 = k_3;
+                                vis1_ = (_e385 + (coeff[_e386] * ((texel1_[_e388] * 2.0) - 1.0)));
                             }
                         }
                     }
                 }
             }
-            float _e403 = vis0_;
-            float _e404 = d;
-            float _e409 = d;
-            vis0_ = ((_e409 <= lohi0_.x) ? 1.0 : ((_e404 > lohi0_.y) ? 0.0 : _e403));
-            float _e414 = vis1_;
-            float _e415 = d;
-            float _e420 = d;
-            vis1_ = ((_e420 <= lohi1_.x) ? 1.0 : ((_e415 > lohi1_.y) ? 0.0 : _e414));
-            bool _e426 = done0_;
-            if (!(_e426)) {
-                float _e429 = total0_;
-                float _e430 = weight0_;
-                float _e431 = vis0_;
-                total0_ = (_e429 + (_e430 * clamp(_e431, 0.0, 1.0)));
+            float _e402 = vis0_;
+            float _e403 = d;
+            float _e408 = d;
+            vis0_ = ((_e408 <= lohi0_.x) ? 1.0 : ((_e403 > lohi0_.y) ? 0.0 : _e402));
+            float _e413 = vis1_;
+            float _e414 = d;
+            float _e419 = d;
+            vis1_ = ((_e419 <= lohi1_.x) ? 1.0 : ((_e414 > lohi1_.y) ? 0.0 : _e413));
+            bool _e425 = done0_;
+            if (!(_e425)) {
+                float _e428 = total0_;
+                float _e429 = weight0_;
+                float _e430 = vis0_;
+                total0_ = (_e428 + (_e429 * clamp(_e430, 0.0, 1.0)));
             }
-            bool _e438 = done1_;
-            if (!(_e438)) {
-                float _e441 = total1_;
-                float _e442 = weight1_;
-                float _e443 = vis1_;
-                total1_ = (_e441 + (_e442 * clamp(_e443, 0.0, 1.0)));
+            bool _e437 = done1_;
+            if (!(_e437)) {
+                float _e440 = total1_;
+                float _e441 = weight1_;
+                float _e442 = vis1_;
+                total1_ = (_e440 + (_e441 * clamp(_e442, 0.0, 1.0)));
             }
-            bool _e449 = done0_;
-            if (!(_e449)) {
+            bool _e448 = done0_;
+            if (!(_e448)) {
                 local_7 = is_last0_;
             } else {
                 local_7 = true;
             }
-            bool _e454 = local_7;
-            done0_ = _e454;
-            bool _e455 = done1_;
-            if (!(_e455)) {
+            bool _e453 = local_7;
+            done0_ = _e453;
+            bool _e454 = done1_;
+            if (!(_e454)) {
                 local_8 = is_last1_;
             } else {
                 local_8 = true;
             }
-            bool _e460 = local_8;
-            done1_ = _e460;
-            bool _e461 = done0_;
-            if (_e461) {
-                bool _e462 = done1_;
-                local_9 = _e462;
+            bool _e459 = local_8;
+            done1_ = _e459;
+            bool _e460 = done0_;
+            if (_e460) {
+                bool _e461 = done1_;
+                local_9 = _e461;
             } else {
                 local_9 = false;
             }
-            bool _e466 = local_9;
-            if (_e466) {
+            bool _e465 = local_9;
+            if (_e465) {
                 break;
             }
         }
     }
-    float _e472 = total0_;
-    float _e474 = total1_;
-    float l_2 = (((1.0 - w1_) * _e472) + (w1_ * _e474));
+    float _e471 = total0_;
+    float _e473 = total1_;
+    float l_2 = (((1.0 - w1_) * _e471) + (w1_ * _e473));
     vec3 c = (color * l_2);
     return c;
 }

@@ -63,6 +63,7 @@ const float PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = 3.1415927;
 const vec4 GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = vec4(-0.8611363, -0.33998105, 0.33998105, 0.8611363);
 const vec4 GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = vec4(0.34785485, 0.65214515, 0.65214515, 0.34785485);
 const float DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX = 0.1;
+const float MOMENT_RANGE_FLOORX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX = 0.1;
 const float MOMENT_BIAS_6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX = 0.0003;
 const float FAR_ROOTX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX = 10000.0;
 const float MOMENT_SPLITX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX = 0.5;
@@ -418,8 +419,15 @@ float spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(FrameX_naga_oil_
     return _e15;
 }
 
-float moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(float d) {
-    return ((2.0 * d) - 1.0);
+uint region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(uint r, uint regions, uint width, bool spot_5) {
+    if (spot_5) {
+        return ((r * width) / regions);
+    }
+    return (((r * r) * width) / (regions * regions));
+}
+
+float moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(float d, vec2 range) {
+    return (((2.0 * d) - (range.x + range.y)) / max((range.y - range.x), MOMENT_RANGE_FLOORX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX));
 }
 
 vec4 biased4X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(vec4 raw, float a_5) {
@@ -560,13 +568,6 @@ float lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(vec4 raw0_, vec2 r
     return clamp(((1.0 - _e129) - (MOMENT_SPLITX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX * wf)), 0.0, 1.0);
 }
 
-uint region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(uint r, uint regions, uint width, bool spot_5) {
-    if (spot_5) {
-        return ((r * width) / regions);
-    }
-    return (((r * r) * width) / (regions * regions));
-}
-
 uint bounds_index(uint x_6, uint row) {
     uint _e5 = _group_0_binding_0_cs.sizes.w;
     return ((x_6 * _e5) + row);
@@ -642,128 +643,126 @@ vec3 scatter_pixel(uint x_9, uint y_1) {
     uint width_1 = (f_13.sizes.z / STRIDE);
     bool wrap_1 = (f_13.anti_epipole.w > 0.5);
     {
-        theta_3 = acos(clamp(dot(_e10, axis), -1.0, 1.0));
-        float _e61 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, _e10);
-        yc = _e61;
-        float _e63 = theta_3;
-        float _e68 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e63, f_13.theta.x, f_13.theta.y);
-        d_1 = _e68;
-        float _e70 = theta_3;
-        float _e71 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, _e10, s_5, _e70, false);
-        reach = _e71;
+        theta_3 = atan(length(cross(_e10, axis)), dot(_e10, axis));
+        float _e60 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, _e10);
+        yc = _e60;
+        float _e62 = theta_3;
+        float _e67 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e62, f_13.theta.x, f_13.theta.y);
+        d_1 = _e67;
+        float _e69 = theta_3;
+        float _e70 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, _e10, s_5, _e69, false);
+        reach = _e70;
     }
-    float _e73 = yc;
-    float yb = (_e73 - 0.5);
+    float _e72 = yc;
+    float yb = (_e72 - 0.5);
     float fy = (yb - floor(yb));
-    uint _e79 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(yb), rows_2, wrap_1);
-    uint _e83 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX((floor(yb) + 1.0), rows_2, wrap_1);
-    uint row1_ = ((yb > floor(yb)) ? _e83 : _e79);
-    float w1_ = ((row1_ != _e79) ? fy : 0.0);
+    uint _e78 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(yb), rows_2, wrap_1);
+    uint _e82 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX((floor(yb) + 1.0), rows_2, wrap_1);
+    uint row1_ = ((yb > floor(yb)) ? _e82 : _e78);
+    float w1_ = ((row1_ != _e78) ? fy : 0.0);
     float cos_theta_l = -(dot(f_13.light_dir.xyz, _e10));
     uint panels_2 = max((f_13.sizes2_.z / 4u), 1u);
-    float _e100 = d_1;
-    float _e101 = moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(_e100);
-    float _e106 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.z, cos_theta_l);
-    float sun_scatter = (f_13.medium.y * _e106);
-    float _e109 = xs;
-    xs0_ = _e109;
-    float _e111 = xs;
-    xs1_ = _e111;
+    float _e103 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.z, cos_theta_l);
+    float sun_scatter = (f_13.medium.y * _e103);
+    float _e106 = xs;
+    xs0_ = _e106;
+    float _e108 = xs;
+    xs1_ = _e108;
     {
-        vec4 _e115 = _group_0_binding_1_cs[_e79];
-        SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e116 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e115);
-        delta0_ = (1.0 * _e116.delta);
-        vec4 _e123 = _group_0_binding_1_cs[row1_];
-        SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e124 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e123);
-        delta1_ = (1.0 * _e124.delta);
+        vec4 _e112 = _group_0_binding_1_cs[_e78];
+        SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e113 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e112);
+        delta0_ = (1.0 * _e113.delta);
+        vec4 _e120 = _group_0_binding_1_cs[row1_];
+        SliceParamsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _e121 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e120);
+        delta1_ = (1.0 * _e121.delta);
+        float _e126 = reach;
+        float _e127 = delta0_;
+        xs0_ = (_e126 / _e127);
         float _e129 = reach;
-        float _e130 = delta0_;
-        xs0_ = (_e129 / _e130);
-        float _e132 = reach;
-        float _e133 = delta1_;
-        xs1_ = (_e132 / _e133);
+        float _e130 = delta1_;
+        xs1_ = (_e129 / _e130);
     }
-    float _e135 = xs0_;
-    uint last0_ = uint(min(max(_e135, 0.0), (float(width_1) - 1.0)));
-    float _e143 = xs1_;
-    uint last1_ = uint(min(max(_e143, 0.0), (float(width_1) - 1.0)));
+    float _e132 = xs0_;
+    uint last0_ = uint(min(max(_e132, 0.0), (float(width_1) - 1.0)));
+    float _e140 = xs1_;
+    uint last1_ = uint(min(max(_e140, 0.0), (float(width_1) - 1.0)));
     bool loop_init_4 = true;
     while(true) {
         if (!loop_init_4) {
-            uint _e410 = r_1;
-            r_1 = (_e410 + 1u);
+            uint _e425 = r_1;
+            r_1 = (_e425 + 1u);
         }
         loop_init_4 = false;
-        uint _e153 = r_1;
-        if ((_e153 < REGIONS)) {
+        uint _e150 = r_1;
+        if ((_e150 < REGIONS)) {
         } else {
             break;
         }
         {
+            uint _e152 = r_1;
+            uint _e153 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e152, REGIONS, width_1, false);
+            float b0_ = float(_e153);
             uint _e155 = r_1;
-            uint _e156 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e155, REGIONS, width_1, false);
-            float b0_ = float(_e156);
-            uint _e158 = r_1;
-            uint _e161 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e158 + 1u), REGIONS, width_1, false);
-            float b1_2 = float(_e161);
+            uint _e158 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e155 + 1u), REGIONS, width_1, false);
+            float b1_2 = float(_e158);
             if (!((last0_ < uint(b1_2)))) {
-                uint _e166 = r_1;
-                local_3 = ((_e166 + 1u) == REGIONS);
+                uint _e163 = r_1;
+                local_3 = ((_e163 + 1u) == REGIONS);
             } else {
                 local_3 = true;
             }
             bool is_last0_ = local_3;
             if (!((last1_ < uint(b1_2)))) {
-                uint _e177 = r_1;
-                local_4 = ((_e177 + 1u) == REGIONS);
+                uint _e174 = r_1;
+                local_4 = ((_e174 + 1u) == REGIONS);
             } else {
                 local_4 = true;
             }
             bool is_last1_ = local_4;
-            float _e187 = xs0_;
-            float pos0_ = (is_last0_ ? clamp((_e187 - 0.5), (b0_ + 0.5), (b1_2 - 0.5)) : (b1_2 - 0.5));
-            float _e198 = xs1_;
-            float pos1_ = (is_last1_ ? clamp((_e198 - 0.5), (b0_ + 0.5), (b1_2 - 0.5)) : (b1_2 - 0.5));
+            float _e184 = xs0_;
+            float pos0_ = (is_last0_ ? clamp((_e184 - 0.5), (b0_ + 0.5), (b1_2 - 0.5)) : (b1_2 - 0.5));
+            float _e195 = xs1_;
+            float pos1_ = (is_last1_ ? clamp((_e195 - 0.5), (b0_ + 0.5), (b1_2 - 0.5)) : (b1_2 - 0.5));
             a0_ = 0.0;
             e0_ = 0.0;
             a1_ = 0.0;
             e1_ = 0.0;
+            float _e212 = delta0_;
+            float _e213 = theta_3;
+            float _e214 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b0_, _e212, _e213, s_5, false);
+            a0_ = _e214;
             float _e215 = delta0_;
             float _e216 = theta_3;
-            float _e217 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b0_, _e215, _e216, s_5, false);
-            a0_ = _e217;
-            float _e218 = delta0_;
-            float _e219 = theta_3;
-            float _e220 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b1_2, _e218, _e219, s_5, false);
-            e0_ = (is_last0_ ? s_5 : _e220);
+            float _e217 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b1_2, _e215, _e216, s_5, false);
+            e0_ = (is_last0_ ? s_5 : _e217);
+            float _e219 = delta1_;
+            float _e220 = theta_3;
+            float _e221 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b0_, _e219, _e220, s_5, false);
+            a1_ = _e221;
             float _e222 = delta1_;
             float _e223 = theta_3;
-            float _e224 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b0_, _e222, _e223, s_5, false);
-            a1_ = _e224;
-            float _e225 = delta1_;
-            float _e226 = theta_3;
-            float _e227 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b1_2, _e225, _e226, s_5, false);
-            e1_ = (is_last1_ ? s_5 : _e227);
+            float _e224 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b1_2, _e222, _e223, s_5, false);
+            e1_ = (is_last1_ ? s_5 : _e224);
             weight0_ = 0.0;
             weight1_ = 0.0;
             if (false) {
-                float _e233 = a0_;
-                float _e234 = e0_;
+                float _e230 = a0_;
+                float _e231 = e0_;
+                float _e232 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, _e10, _e230, _e231, panels_2);
+                weight0_ = _e232;
+                float _e233 = a1_;
+                float _e234 = e1_;
                 float _e235 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, _e10, _e233, _e234, panels_2);
-                weight0_ = _e235;
-                float _e236 = a1_;
-                float _e237 = e1_;
-                float _e238 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, _e10, _e236, _e237, panels_2);
-                weight1_ = _e238;
+                weight1_ = _e235;
             } else {
-                float _e241 = a0_;
-                float _e242 = e0_;
-                float _e243 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.x, _e241, _e242);
-                weight0_ = (sun_scatter * _e243);
-                float _e247 = a1_;
-                float _e248 = e1_;
-                float _e249 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.x, _e247, _e248);
-                weight1_ = (sun_scatter * _e249);
+                float _e238 = a0_;
+                float _e239 = e0_;
+                float _e240 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.x, _e238, _e239);
+                weight0_ = (sun_scatter * _e240);
+                float _e244 = a1_;
+                float _e245 = e1_;
+                float _e246 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.x, _e244, _e245);
+                weight1_ = (sun_scatter * _e246);
             }
             float xb0_ = (pos0_ - 0.5);
             float fx0_ = (xb0_ - floor(xb0_));
@@ -773,102 +772,110 @@ vec3 scatter_pixel(uint x_9, uint y_1) {
             float fx1_ = (xb1_ - floor(xb1_));
             uint x10_ = uint(clamp(floor(xb1_), 0.0, (float(width_1) - 1.0)));
             uint x11_ = ((xb1_ > floor(xb1_)) ? min((x10_ + 1u), (width_1 - 1u)) : x10_);
-            uint _e289 = bounds_index(x01_, _e79);
-            vec2 lohi0_ = _group_0_binding_6_cs[_e289];
-            uint _e293 = bounds_index(x11_, row1_);
-            vec2 lohi1_ = _group_0_binding_6_cs[_e293];
+            uint _e286 = bounds_index(x01_, _e78);
+            vec2 lohi0_ = _group_0_binding_6_cs[_e286];
+            uint _e290 = bounds_index(x11_, row1_);
+            vec2 lohi1_ = _group_0_binding_6_cs[_e290];
             vis0_ = 0.5;
             vis1_ = 0.5;
-            float _e301 = d_1;
-            if ((_e301 > lohi0_.x)) {
-                float _e304 = d_1;
-                local_5 = (_e304 <= lohi0_.y);
+            float _e298 = d_1;
+            if ((_e298 > lohi0_.x)) {
+                float _e301 = d_1;
+                local_5 = (_e301 <= lohi0_.y);
             } else {
                 local_5 = false;
             }
-            bool _e310 = local_5;
-            if (_e310) {
-                vec4 _e312 = filtered_load(x00_, _e79, 0u);
-                vec4 _e314 = filtered_load(x01_, _e79, 0u);
-                vec4 m0_ = mix(_e312, _e314, fx0_);
-                vec4 _e317 = filtered_load(x00_, _e79, 1u);
-                vec4 _e319 = filtered_load(x01_, _e79, 1u);
-                vec4 m1_ = mix(_e317, _e319, fx0_);
-                float _e322 = lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(m0_, m1_.xy, _e101);
-                vis0_ = _e322;
+            bool _e307 = local_5;
+            if (_e307) {
+                float _e308 = d_1;
+                uint _e312 = bounds_index((uint(b1_2) - 1u), _e78);
+                vec2 _e315 = _group_0_binding_6_cs[_e312];
+                float _e316 = moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(_e308, _e315);
+                vec4 _e318 = filtered_load(x00_, _e78, 0u);
+                vec4 _e320 = filtered_load(x01_, _e78, 0u);
+                vec4 m0_ = mix(_e318, _e320, fx0_);
+                vec4 _e323 = filtered_load(x00_, _e78, 1u);
+                vec4 _e325 = filtered_load(x01_, _e78, 1u);
+                vec4 m1_ = mix(_e323, _e325, fx0_);
+                float _e328 = lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(m0_, m1_.xy, _e316);
+                vis0_ = _e328;
             }
-            float _e323 = d_1;
-            if ((_e323 > lohi1_.x)) {
-                float _e326 = d_1;
-                local_6 = (_e326 <= lohi1_.y);
+            float _e329 = d_1;
+            if ((_e329 > lohi1_.x)) {
+                float _e332 = d_1;
+                local_6 = (_e332 <= lohi1_.y);
             } else {
                 local_6 = false;
             }
-            bool _e332 = local_6;
-            if (_e332) {
-                vec4 _e334 = filtered_load(x10_, row1_, 0u);
-                vec4 _e336 = filtered_load(x11_, row1_, 0u);
-                vec4 m0_1 = mix(_e334, _e336, fx1_);
-                vec4 _e339 = filtered_load(x10_, row1_, 1u);
-                vec4 _e341 = filtered_load(x11_, row1_, 1u);
-                vec4 m1_1 = mix(_e339, _e341, fx1_);
-                float _e344 = lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(m0_1, m1_1.xy, _e101);
-                vis1_ = _e344;
+            bool _e338 = local_6;
+            if (_e338) {
+                float _e339 = d_1;
+                uint _e343 = bounds_index((uint(b1_2) - 1u), row1_);
+                vec2 _e346 = _group_0_binding_6_cs[_e343];
+                float _e347 = moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(_e339, _e346);
+                vec4 _e349 = filtered_load(x10_, row1_, 0u);
+                vec4 _e351 = filtered_load(x11_, row1_, 0u);
+                vec4 m0_1 = mix(_e349, _e351, fx1_);
+                vec4 _e354 = filtered_load(x10_, row1_, 1u);
+                vec4 _e356 = filtered_load(x11_, row1_, 1u);
+                vec4 m1_1 = mix(_e354, _e356, fx1_);
+                float _e359 = lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(m0_1, m1_1.xy, _e347);
+                vis1_ = _e359;
             }
-            float _e345 = vis0_;
-            float _e346 = d_1;
-            float _e351 = d_1;
-            vis0_ = ((_e351 <= lohi0_.x) ? 1.0 : ((_e346 > lohi0_.y) ? 0.0 : _e345));
-            float _e356 = vis1_;
-            float _e357 = d_1;
-            float _e362 = d_1;
-            vis1_ = ((_e362 <= lohi1_.x) ? 1.0 : ((_e357 > lohi1_.y) ? 0.0 : _e356));
-            bool _e368 = done0_;
-            if (!(_e368)) {
-                float _e371 = total0_;
-                float _e372 = weight0_;
-                float _e373 = vis0_;
-                total0_ = (_e371 + (_e372 * clamp(_e373, 0.0, 1.0)));
+            float _e360 = vis0_;
+            float _e361 = d_1;
+            float _e366 = d_1;
+            vis0_ = ((_e366 <= lohi0_.x) ? 1.0 : ((_e361 > lohi0_.y) ? 0.0 : _e360));
+            float _e371 = vis1_;
+            float _e372 = d_1;
+            float _e377 = d_1;
+            vis1_ = ((_e377 <= lohi1_.x) ? 1.0 : ((_e372 > lohi1_.y) ? 0.0 : _e371));
+            bool _e383 = done0_;
+            if (!(_e383)) {
+                float _e386 = total0_;
+                float _e387 = weight0_;
+                float _e388 = vis0_;
+                total0_ = (_e386 + (_e387 * clamp(_e388, 0.0, 1.0)));
             }
-            bool _e380 = done1_;
-            if (!(_e380)) {
-                float _e383 = total1_;
-                float _e384 = weight1_;
-                float _e385 = vis1_;
-                total1_ = (_e383 + (_e384 * clamp(_e385, 0.0, 1.0)));
+            bool _e395 = done1_;
+            if (!(_e395)) {
+                float _e398 = total1_;
+                float _e399 = weight1_;
+                float _e400 = vis1_;
+                total1_ = (_e398 + (_e399 * clamp(_e400, 0.0, 1.0)));
             }
-            bool _e391 = done0_;
-            if (!(_e391)) {
+            bool _e406 = done0_;
+            if (!(_e406)) {
                 local_7 = is_last0_;
             } else {
                 local_7 = true;
             }
-            bool _e396 = local_7;
-            done0_ = _e396;
-            bool _e397 = done1_;
-            if (!(_e397)) {
+            bool _e411 = local_7;
+            done0_ = _e411;
+            bool _e412 = done1_;
+            if (!(_e412)) {
                 local_8 = is_last1_;
             } else {
                 local_8 = true;
             }
-            bool _e402 = local_8;
-            done1_ = _e402;
-            bool _e403 = done0_;
-            if (_e403) {
-                bool _e404 = done1_;
-                local_9 = _e404;
+            bool _e417 = local_8;
+            done1_ = _e417;
+            bool _e418 = done0_;
+            if (_e418) {
+                bool _e419 = done1_;
+                local_9 = _e419;
             } else {
                 local_9 = false;
             }
-            bool _e408 = local_9;
-            if (_e408) {
+            bool _e423 = local_9;
+            if (_e423) {
                 break;
             }
         }
     }
-    float _e414 = total0_;
-    float _e416 = total1_;
-    float l_2 = (((1.0 - w1_) * _e414) + (w1_ * _e416));
+    float _e429 = total0_;
+    float _e431 = total1_;
+    float l_2 = (((1.0 - w1_) * _e429) + (w1_ * _e431));
     vec3 c_1 = (color * l_2);
     return c_1;
 }

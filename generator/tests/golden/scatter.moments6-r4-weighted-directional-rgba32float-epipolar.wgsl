@@ -63,6 +63,7 @@ const PIX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX: f32 = 3.1415927f;
 const GL4_XX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX: vec4<f32> = vec4<f32>(-0.8611363f, -0.33998105f, 0.33998105f, 0.8611363f);
 const GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX: vec4<f32> = vec4<f32>(0.34785485f, 0.65214515f, 0.65214515f, 0.34785485f);
 const DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX: f32 = 0.1f;
+const MOMENT_RANGE_FLOORX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX: f32 = 0.1f;
 const MOMENT_BIAS_6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX: f32 = 0.0003f;
 const FAR_ROOTX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX: f32 = 10000f;
 const MOMENT_SPLITX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX: f32 = 0.5f;
@@ -414,8 +415,15 @@ fn spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_11: FrameX_naga_o
     return _e15;
 }
 
-fn moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(d: f32) -> f32 {
-    return ((2f * d) - 1f);
+fn region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(r: u32, regions: u32, width: u32, spot_5: bool) -> u32 {
+    if spot_5 {
+        return ((r * width) / regions);
+    }
+    return (((r * r) * width) / (regions * regions));
+}
+
+fn moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(d: f32, range: vec2<f32>) -> f32 {
+    return (((2f * d) - (range.x + range.y)) / max((range.y - range.x), MOMENT_RANGE_FLOORX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX));
 }
 
 fn biased4X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(raw: vec4<f32>, a_5: f32) -> vec4<f32> {
@@ -556,13 +564,6 @@ fn lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(raw0_: vec4<f32>, raw
     return clamp(((1f - _e129) - (MOMENT_SPLITX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX * wf)), 0f, 1f);
 }
 
-fn region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(r: u32, regions: u32, width: u32, spot_5: bool) -> u32 {
-    if spot_5 {
-        return ((r * width) / regions);
-    }
-    return (((r * r) * width) / (regions * regions));
-}
-
 fn bounds_index(x_6: u32, row: u32) -> u32 {
     let _e5 = frame.sizes.w;
     return ((x_6 * _e5) + row);
@@ -638,122 +639,120 @@ fn scatter_pixel(x_9: u32, y_1: u32) -> vec3<f32> {
     let width_1 = (f_13.sizes.z / STRIDE);
     let wrap_1 = (f_13.anti_epipole.w > 0.5f);
     {
-        theta_3 = acos(clamp(dot(_e10, axis), -1f, 1f));
-        let _e61 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, _e10);
-        yc = _e61;
-        let _e63 = theta_3;
-        let _e68 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e63, f_13.theta.x, f_13.theta.y);
-        d_1 = _e68;
-        let _e70 = theta_3;
-        let _e71 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, _e10, s_5, _e70, false);
-        reach = _e71;
+        theta_3 = atan2(length(cross(_e10, axis)), dot(_e10, axis));
+        let _e60 = ray_row_coordX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, _e10);
+        yc = _e60;
+        let _e62 = theta_3;
+        let _e67 = normalised_depthX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e62, f_13.theta.x, f_13.theta.y);
+        d_1 = _e67;
+        let _e69 = theta_3;
+        let _e70 = ray_columnX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, _e10, s_5, _e69, false);
+        reach = _e70;
     }
-    let _e73 = yc;
-    let yb = (_e73 - 0.5f);
+    let _e72 = yc;
+    let yb = (_e72 - 0.5f);
     let fy = (yb - floor(yb));
-    let _e79 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(yb), rows_2, wrap_1);
-    let _e83 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX((floor(yb) + 1f), rows_2, wrap_1);
-    let row1_ = select(_e79, _e83, (yb > floor(yb)));
-    let w1_ = select(0f, fy, (row1_ != _e79));
+    let _e78 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(floor(yb), rows_2, wrap_1);
+    let _e82 = row_indexX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX((floor(yb) + 1f), rows_2, wrap_1);
+    let row1_ = select(_e78, _e82, (yb > floor(yb)));
+    let w1_ = select(0f, fy, (row1_ != _e78));
     let cos_theta_l = -(dot(f_13.light_dir.xyz, _e10));
     let panels_2 = max((f_13.sizes2_.z / 4u), 1u);
-    let _e100 = d_1;
-    let _e101 = moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(_e100);
-    let _e106 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.z, cos_theta_l);
-    let sun_scatter = (f_13.medium.y * _e106);
-    let _e109 = xs;
-    xs0_ = _e109;
-    let _e111 = xs;
-    xs1_ = _e111;
+    let _e103 = phase_hgX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.z, cos_theta_l);
+    let sun_scatter = (f_13.medium.y * _e103);
+    let _e106 = xs;
+    xs0_ = _e106;
+    let _e108 = xs;
+    xs1_ = _e108;
     {
-        let _e115 = slices[_e79];
-        let _e116 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e115);
-        delta0_ = (1f * _e116.delta);
-        let _e123 = slices[row1_];
-        let _e124 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e123);
-        delta1_ = (1f * _e124.delta);
+        let _e112 = slices[_e78];
+        let _e113 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e112);
+        delta0_ = (1f * _e113.delta);
+        let _e120 = slices[row1_];
+        let _e121 = slice_paramsX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(_e120);
+        delta1_ = (1f * _e121.delta);
+        let _e126 = reach;
+        let _e127 = delta0_;
+        xs0_ = (_e126 / _e127);
         let _e129 = reach;
-        let _e130 = delta0_;
-        xs0_ = (_e129 / _e130);
-        let _e132 = reach;
-        let _e133 = delta1_;
-        xs1_ = (_e132 / _e133);
+        let _e130 = delta1_;
+        xs1_ = (_e129 / _e130);
     }
-    let _e135 = xs0_;
-    let last0_ = u32(min(max(_e135, 0f), (f32(width_1) - 1f)));
-    let _e143 = xs1_;
-    let last1_ = u32(min(max(_e143, 0f), (f32(width_1) - 1f)));
+    let _e132 = xs0_;
+    let last0_ = u32(min(max(_e132, 0f), (f32(width_1) - 1f)));
+    let _e140 = xs1_;
+    let last1_ = u32(min(max(_e140, 0f), (f32(width_1) - 1f)));
     loop {
-        let _e153 = r_1;
-        if (_e153 < REGIONS) {
+        let _e150 = r_1;
+        if (_e150 < REGIONS) {
         } else {
             break;
         }
         {
+            let _e152 = r_1;
+            let _e153 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e152, REGIONS, width_1, false);
+            let b0_ = f32(_e153);
             let _e155 = r_1;
-            let _e156 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e155, REGIONS, width_1, false);
-            let b0_ = f32(_e156);
-            let _e158 = r_1;
-            let _e161 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e158 + 1u), REGIONS, width_1, false);
-            let b1_2 = f32(_e161);
+            let _e158 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e155 + 1u), REGIONS, width_1, false);
+            let b1_2 = f32(_e158);
             if !((last0_ < u32(b1_2))) {
-                let _e166 = r_1;
-                local_3 = ((_e166 + 1u) == REGIONS);
+                let _e163 = r_1;
+                local_3 = ((_e163 + 1u) == REGIONS);
             } else {
                 local_3 = true;
             }
             let is_last0_ = local_3;
             if !((last1_ < u32(b1_2))) {
-                let _e177 = r_1;
-                local_4 = ((_e177 + 1u) == REGIONS);
+                let _e174 = r_1;
+                local_4 = ((_e174 + 1u) == REGIONS);
             } else {
                 local_4 = true;
             }
             let is_last1_ = local_4;
-            let _e187 = xs0_;
-            let pos0_ = select((b1_2 - 0.5f), clamp((_e187 - 0.5f), (b0_ + 0.5f), (b1_2 - 0.5f)), is_last0_);
-            let _e198 = xs1_;
-            let pos1_ = select((b1_2 - 0.5f), clamp((_e198 - 0.5f), (b0_ + 0.5f), (b1_2 - 0.5f)), is_last1_);
+            let _e184 = xs0_;
+            let pos0_ = select((b1_2 - 0.5f), clamp((_e184 - 0.5f), (b0_ + 0.5f), (b1_2 - 0.5f)), is_last0_);
+            let _e195 = xs1_;
+            let pos1_ = select((b1_2 - 0.5f), clamp((_e195 - 0.5f), (b0_ + 0.5f), (b1_2 - 0.5f)), is_last1_);
             a0_ = f32();
             e0_ = f32();
             a1_ = f32();
             e1_ = f32();
+            let _e212 = delta0_;
+            let _e213 = theta_3;
+            let _e214 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b0_, _e212, _e213, s_5, false);
+            a0_ = _e214;
             let _e215 = delta0_;
             let _e216 = theta_3;
-            let _e217 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b0_, _e215, _e216, s_5, false);
-            a0_ = _e217;
-            let _e218 = delta0_;
-            let _e219 = theta_3;
-            let _e220 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b1_2, _e218, _e219, s_5, false);
-            e0_ = select(_e220, s_5, is_last0_);
+            let _e217 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b1_2, _e215, _e216, s_5, false);
+            e0_ = select(_e217, s_5, is_last0_);
+            let _e219 = delta1_;
+            let _e220 = theta_3;
+            let _e221 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b0_, _e219, _e220, s_5, false);
+            a1_ = _e221;
             let _e222 = delta1_;
             let _e223 = theta_3;
-            let _e224 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b0_, _e222, _e223, s_5, false);
-            a1_ = _e224;
-            let _e225 = delta1_;
-            let _e226 = theta_3;
-            let _e227 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b1_2, _e225, _e226, s_5, false);
-            e1_ = select(_e227, s_5, is_last1_);
+            let _e224 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b1_2, _e222, _e223, s_5, false);
+            e1_ = select(_e224, s_5, is_last1_);
             weight0_ = f32();
             weight1_ = f32();
             if false {
-                let _e233 = a0_;
-                let _e234 = e0_;
+                let _e230 = a0_;
+                let _e231 = e0_;
+                let _e232 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, _e10, _e230, _e231, panels_2);
+                weight0_ = _e232;
+                let _e233 = a1_;
+                let _e234 = e1_;
                 let _e235 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, _e10, _e233, _e234, panels_2);
-                weight0_ = _e235;
-                let _e236 = a1_;
-                let _e237 = e1_;
-                let _e238 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, _e10, _e236, _e237, panels_2);
-                weight1_ = _e238;
+                weight1_ = _e235;
             } else {
-                let _e241 = a0_;
-                let _e242 = e0_;
-                let _e243 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.x, _e241, _e242);
-                weight0_ = (sun_scatter * _e243);
-                let _e247 = a1_;
-                let _e248 = e1_;
-                let _e249 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.x, _e247, _e248);
-                weight1_ = (sun_scatter * _e249);
+                let _e238 = a0_;
+                let _e239 = e0_;
+                let _e240 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.x, _e238, _e239);
+                weight0_ = (sun_scatter * _e240);
+                let _e244 = a1_;
+                let _e245 = e1_;
+                let _e246 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.x, _e244, _e245);
+                weight1_ = (sun_scatter * _e246);
             }
             let xb0_ = (pos0_ - 0.5f);
             let fx0_ = (xb0_ - floor(xb0_));
@@ -763,106 +762,114 @@ fn scatter_pixel(x_9: u32, y_1: u32) -> vec3<f32> {
             let fx1_ = (xb1_ - floor(xb1_));
             let x10_ = u32(clamp(floor(xb1_), 0f, (f32(width_1) - 1f)));
             let x11_ = select(x10_, min((x10_ + 1u), (width_1 - 1u)), (xb1_ > floor(xb1_)));
-            let _e289 = bounds_index(x01_, _e79);
-            let lohi0_ = bounds[_e289];
-            let _e293 = bounds_index(x11_, row1_);
-            let lohi1_ = bounds[_e293];
+            let _e286 = bounds_index(x01_, _e78);
+            let lohi0_ = bounds[_e286];
+            let _e290 = bounds_index(x11_, row1_);
+            let lohi1_ = bounds[_e290];
             vis0_ = 0.5f;
             vis1_ = 0.5f;
-            let _e301 = d_1;
-            if (_e301 > lohi0_.x) {
-                let _e304 = d_1;
-                local_5 = (_e304 <= lohi0_.y);
+            let _e298 = d_1;
+            if (_e298 > lohi0_.x) {
+                let _e301 = d_1;
+                local_5 = (_e301 <= lohi0_.y);
             } else {
                 local_5 = false;
             }
-            let _e310 = local_5;
-            if _e310 {
-                let _e312 = filtered_load(x00_, _e79, 0u);
-                let _e314 = filtered_load(x01_, _e79, 0u);
-                let m0_ = mix(_e312, _e314, fx0_);
-                let _e317 = filtered_load(x00_, _e79, 1u);
-                let _e319 = filtered_load(x01_, _e79, 1u);
-                let m1_ = mix(_e317, _e319, fx0_);
-                let _e322 = lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(m0_, m1_.xy, _e101);
-                vis0_ = _e322;
+            let _e307 = local_5;
+            if _e307 {
+                let _e308 = d_1;
+                let _e312 = bounds_index((u32(b1_2) - 1u), _e78);
+                let _e315 = bounds[_e312];
+                let _e316 = moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(_e308, _e315);
+                let _e318 = filtered_load(x00_, _e78, 0u);
+                let _e320 = filtered_load(x01_, _e78, 0u);
+                let m0_ = mix(_e318, _e320, fx0_);
+                let _e323 = filtered_load(x00_, _e78, 1u);
+                let _e325 = filtered_load(x01_, _e78, 1u);
+                let m1_ = mix(_e323, _e325, fx0_);
+                let _e328 = lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(m0_, m1_.xy, _e316);
+                vis0_ = _e328;
             }
-            let _e323 = d_1;
-            if (_e323 > lohi1_.x) {
-                let _e326 = d_1;
-                local_6 = (_e326 <= lohi1_.y);
+            let _e329 = d_1;
+            if (_e329 > lohi1_.x) {
+                let _e332 = d_1;
+                local_6 = (_e332 <= lohi1_.y);
             } else {
                 local_6 = false;
             }
-            let _e332 = local_6;
-            if _e332 {
-                let _e334 = filtered_load(x10_, row1_, 0u);
-                let _e336 = filtered_load(x11_, row1_, 0u);
-                let m0_1 = mix(_e334, _e336, fx1_);
-                let _e339 = filtered_load(x10_, row1_, 1u);
-                let _e341 = filtered_load(x11_, row1_, 1u);
-                let m1_1 = mix(_e339, _e341, fx1_);
-                let _e344 = lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(m0_1, m1_1.xy, _e101);
-                vis1_ = _e344;
+            let _e338 = local_6;
+            if _e338 {
+                let _e339 = d_1;
+                let _e343 = bounds_index((u32(b1_2) - 1u), row1_);
+                let _e346 = bounds[_e343];
+                let _e347 = moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(_e339, _e346);
+                let _e349 = filtered_load(x10_, row1_, 0u);
+                let _e351 = filtered_load(x11_, row1_, 0u);
+                let m0_1 = mix(_e349, _e351, fx1_);
+                let _e354 = filtered_load(x10_, row1_, 1u);
+                let _e356 = filtered_load(x11_, row1_, 1u);
+                let m1_1 = mix(_e354, _e356, fx1_);
+                let _e359 = lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(m0_1, m1_1.xy, _e347);
+                vis1_ = _e359;
             }
-            let _e345 = vis0_;
-            let _e346 = d_1;
-            let _e351 = d_1;
-            vis0_ = select(select(_e345, 0f, (_e346 > lohi0_.y)), 1f, (_e351 <= lohi0_.x));
-            let _e356 = vis1_;
-            let _e357 = d_1;
-            let _e362 = d_1;
-            vis1_ = select(select(_e356, 0f, (_e357 > lohi1_.y)), 1f, (_e362 <= lohi1_.x));
-            let _e368 = done0_;
-            if !(_e368) {
-                let _e371 = total0_;
-                let _e372 = weight0_;
-                let _e373 = vis0_;
-                total0_ = (_e371 + (_e372 * clamp(_e373, 0f, 1f)));
+            let _e360 = vis0_;
+            let _e361 = d_1;
+            let _e366 = d_1;
+            vis0_ = select(select(_e360, 0f, (_e361 > lohi0_.y)), 1f, (_e366 <= lohi0_.x));
+            let _e371 = vis1_;
+            let _e372 = d_1;
+            let _e377 = d_1;
+            vis1_ = select(select(_e371, 0f, (_e372 > lohi1_.y)), 1f, (_e377 <= lohi1_.x));
+            let _e383 = done0_;
+            if !(_e383) {
+                let _e386 = total0_;
+                let _e387 = weight0_;
+                let _e388 = vis0_;
+                total0_ = (_e386 + (_e387 * clamp(_e388, 0f, 1f)));
             }
-            let _e380 = done1_;
-            if !(_e380) {
-                let _e383 = total1_;
-                let _e384 = weight1_;
-                let _e385 = vis1_;
-                total1_ = (_e383 + (_e384 * clamp(_e385, 0f, 1f)));
+            let _e395 = done1_;
+            if !(_e395) {
+                let _e398 = total1_;
+                let _e399 = weight1_;
+                let _e400 = vis1_;
+                total1_ = (_e398 + (_e399 * clamp(_e400, 0f, 1f)));
             }
-            let _e391 = done0_;
-            if !(_e391) {
+            let _e406 = done0_;
+            if !(_e406) {
                 local_7 = is_last0_;
             } else {
                 local_7 = true;
             }
-            let _e396 = local_7;
-            done0_ = _e396;
-            let _e397 = done1_;
-            if !(_e397) {
+            let _e411 = local_7;
+            done0_ = _e411;
+            let _e412 = done1_;
+            if !(_e412) {
                 local_8 = is_last1_;
             } else {
                 local_8 = true;
             }
-            let _e402 = local_8;
-            done1_ = _e402;
-            let _e403 = done0_;
-            if _e403 {
-                let _e404 = done1_;
-                local_9 = _e404;
+            let _e417 = local_8;
+            done1_ = _e417;
+            let _e418 = done0_;
+            if _e418 {
+                let _e419 = done1_;
+                local_9 = _e419;
             } else {
                 local_9 = false;
             }
-            let _e408 = local_9;
-            if _e408 {
+            let _e423 = local_9;
+            if _e423 {
                 break;
             }
         }
         continuing {
-            let _e410 = r_1;
-            r_1 = (_e410 + 1u);
+            let _e425 = r_1;
+            r_1 = (_e425 + 1u);
         }
     }
-    let _e414 = total0_;
-    let _e416 = total1_;
-    let l_2 = (((1f - w1_) * _e414) + (w1_ * _e416));
+    let _e429 = total0_;
+    let _e431 = total1_;
+    let l_2 = (((1f - w1_) * _e429) + (w1_ * _e431));
     let c_1 = (color * l_2);
     return c_1;
 }

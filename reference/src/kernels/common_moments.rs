@@ -4,7 +4,8 @@
 //! bounds (4 moments: Hamburger 4MSM; 6 moments: a cubic). Written line by line like the WGSL.
 //!
 //! The math. A region's texels up to a column, weighted, are a distribution of occluder
-//! depths `z = 2 d - 1` in `[-1, 1]`; the prefilter stores its power moments
+//! depths `z` in `[-1, 1]` ([`moment_z`]: the depth mapped from the region's whole depth
+//! range, so that every region's moments use the full interval); the prefilter stores its power moments
 //! `b_k = E[z^k]`, `k = 1..=2n` (`n` = 2 or 3). A ray at depth `zf` is lit where `z >= zf`,
 //! so the region's visibility is `1 - P(z < zf)`. Among all distributions with these
 //! moments, `P(z < zf)` is least and greatest for the one with `n + 1` atoms, one of them at
@@ -36,9 +37,21 @@ pub const MOMENT_SPLIT: f32 = 0.5;
 /// is below 1e-4 and its position no longer matters.
 pub const FAR_ROOT: f32 = 1e4;
 
-/// The moment coordinate of a normalised depth: `z = 2 d - 1`.
-pub fn moment_z(d: f32) -> f32 {
-    2.0 * d - 1.0
+/// The least depth range [`moment_z`] stretches to `[-1, 1]`: a narrower region's depths
+/// fill `[-w / MOMENT_RANGE_FLOOR, w / MOMENT_RANGE_FLOOR]` of it, so the map's rounding
+/// (the GPU's and the mirror's rectified depths differ by ~1e-6) grows at most 20-fold.
+/// Accuracy is the same as without a floor down to 0.1 (mean rel L1 over the 24 suite poses
+/// 1.098 % at 6 moments and 8 regions, 0.669 % at 16; 0.3: 1.103 / 0.675 %).
+pub const MOMENT_RANGE_FLOOR: f32 = 0.1;
+
+/// The moment coordinate of a normalised depth `d` in a region whose depths span
+/// `range = [least, greatest]`: `z = (2 d - least - greatest) / max(greatest - least,
+/// MOMENT_RANGE_FLOOR)`, so the region's depths fill `[-1, 1]`. With `z = 2 d - 1` over the
+/// whole map a region's depths filled a fraction of the interval, where the bias and f32
+/// rounding blurred them: 6 moments, 8 regions, mean rel L1 over the 24 suite poses 1.38 ->
+/// 1.10 %, window/ordinary 8.01 -> 4.34 % (`prefiltered_truth`, 320x180).
+pub fn moment_z(d: f32, range: [f32; 2]) -> f32 {
+    (2.0 * d - (range[0] + range[1])) / (range[1] - range[0]).max(MOMENT_RANGE_FLOOR)
 }
 
 /// Layer `layer` of the power moments of `z`: `(z, z^2, z^3, z^4)` (layer 0) or
@@ -258,6 +271,18 @@ mod tests {
             [m[0] as f32, m[1] as f32, m[2] as f32, m[3] as f32],
             [m[4] as f32, m[5] as f32],
         )
+    }
+
+    /// The moment coordinate fills [-1, 1] over a region's range, a part of it below the
+    /// floor, and is 0 for one depth.
+    #[test]
+    fn moment_z_spans_the_range() {
+        assert_eq!(moment_z(0.2, [0.2, 0.6]), -1.0);
+        assert_eq!(moment_z(0.6, [0.2, 0.6]), 1.0);
+        assert!((moment_z(0.4, [0.2, 0.6])).abs() < 1e-6);
+        assert!((moment_z(0.52, [0.5, 0.54]) + 0.0).abs() < 1e-6);
+        assert!((moment_z(0.54, [0.5, 0.54]) - 0.4).abs() < 1e-5);
+        assert_eq!(moment_z(0.3, [0.3, 0.3]), 0.0);
     }
 
     /// Two depths: 4 moments already determine the distribution, so the reconstruction is

@@ -111,6 +111,18 @@ pub fn prefilter_main(
     let mut wsum = 0.0f32;
     let mut lo = 1e30f32;
     let mut hi = -1e30f32;
+    // The region's whole depth range (what `bounds` holds at its last stored column), which
+    // `moment_z` maps to [-1, 1]: one pass of depth loads before the moments.
+    let mut depth_range = [1e30f32, -1e30f32];
+    if moments {
+        for i in start..end {
+            let mut d = rectified.load(i, row);
+            if proj {
+                d = proj_stored_depth(d);
+            }
+            depth_range = [depth_range[0].min(d), depth_range[1].max(d)];
+        }
+    }
     for i in start..end {
         let mut d = rectified.load(i, row);
         let w;
@@ -178,8 +190,8 @@ pub fn prefilter_main(
             *a
         };
         if moments {
-            // The power moments of z, stored as they are.
-            let z = moment_z(d);
+            // The power moments of z in the region's range, stored as they are.
+            let z = moment_z(d, depth_range);
             for q in 0..layers_per_thread {
                 let b = moment_layer(z, q);
                 for c in 0..channels {

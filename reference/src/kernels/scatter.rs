@@ -126,7 +126,9 @@ pub fn scatter_main(
         }
         xs = proj_column(f, g, regions, width, spot);
     } else {
-        theta = clamp(dir.dot(axis), -1.0, 1.0).acos();
+        // The view angle from the light axis as atan2(|dir x axis|, dir . axis): acos of the
+        // dot product resolves angles near the axis only to sqrt(2 * 6e-8) = 3.5e-4 in f32.
+        theta = dir.cross(axis).length().atan2(dir.dot(axis));
         yc = ray_row_coord(f, dir);
         d = normalised_depth(theta, f.theta[0], f.theta[1]);
         reach = ray_column(f, eye, dir, s, theta, spot);
@@ -150,9 +152,9 @@ pub fn scatter_main(
     let panels = max_u(f.sizes2[2] / 4, 1);
     // The ray's Fourier coefficients depend on its depth only: once per pixel, their angles
     // by angle addition from pi d.
-    // (The moment basis: the ray's depth in the moments' coordinate instead.)
+    // (The moment basis: the ray's depth in the region's moment coordinate instead, per
+    // region and row below.)
     let moments = variant.basis == Basis::Moments;
-    let zf = moment_z(d);
     let mut coeffs = Vec::with_capacity(variant.layers() as usize);
     if !moments {
         let mut angle = [(PI * d).sin(), (PI * d).cos()];
@@ -265,6 +267,12 @@ pub fn scatter_main(
         let lohi0 = inp.bounds.load(x01, row0, 0);
         let lohi1 = inp.bounds.load(x11, row1, 0);
         let ambiguous = |lohi: [f32; 4]| d > lohi[0] && d <= lohi[1];
+        // The ray's depth in a row's moment coordinate: the region's whole depth range is its
+        // bounds at its last stored column (`moment_z`).
+        let zf_of = |row: u32| {
+            let range = inp.bounds.load(b1 as u32 - 1, row, 0);
+            moment_z(d, [range[0], range[1]])
+        };
         let (add0, add1) = if tinted {
             tinted_region(
                 inp,
@@ -272,7 +280,11 @@ pub fn scatter_main(
                 [(x00, x01, fx0, row0), (x10, x11, fx1, row1)],
                 [lohi0, lohi1],
                 d,
-                zf,
+                if moments {
+                    [zf_of(row0), zf_of(row1)]
+                } else {
+                    [0.0; 2]
+                },
                 &coeffs,
             )
         } else {
@@ -280,6 +292,7 @@ pub fn scatter_main(
             if moments {
                 // The region's moments, filtered linearly along each row.
                 let lit = |x0: u32, x1: u32, fx: f32, row: u32| {
+                    let zf = zf_of(row);
                     let fetch = |layer: u32| {
                         let load = |x: u32| inp.filtered.load(x, row, layer);
                         mix4(load(x0), load(x1), fx)
@@ -346,7 +359,8 @@ pub fn scatter_main(
 }
 
 /// A region's cookie-weighted lit fraction per colour channel, for both rows (`texels`: each
-/// row's two columns, the second's weight and the row; `lohi`: their depth bounds): the lit
+/// row's two columns, the second's weight and the row; `lohi`: their depth bounds; `zf`: the
+/// ray's depth in each row's moment coordinate, unused with Fourier bases): the lit
 /// share clamped to [0, Cbar] over Cbar, 0 where Cbar is (see the WGSL comment).
 fn tinted_region(
     inp: &ScatterInputs,
@@ -354,7 +368,7 @@ fn tinted_region(
     texels: [(u32, u32, f32, u32); 2],
     lohi: [[f32; 4]; 2],
     d: f32,
-    zf: f32,
+    zf: [f32; 2],
     coeffs: &[[f32; 4]],
 ) -> (Vec3, Vec3) {
     let layers = variant.layers();
@@ -381,9 +395,9 @@ fn tinted_region(
                     vis[row][c] = cb
                         * if variant.moments == 6 {
                             let m1 = fetch(texels[row], c as u32 * layers + 1).map(|v| v / cb);
-                            lit_moments6(m0, [m1[0], m1[1]], zf)
+                            lit_moments6(m0, [m1[0], m1[1]], zf[row])
                         } else {
-                            lit_moments4(m0, zf)
+                            lit_moments4(m0, zf[row])
                         };
                 }
             }

@@ -27,9 +27,6 @@ pub const RECTIFY_WORKGROUP_SIZE: [u32; 3] = [8, 8, 1];
 pub const PREFILTER_WORKGROUP_SIZE: [u32; 3] = [64, 1, 1];
 /// Workgroup size of `scatter`: one invocation per screen pixel.
 pub const SCATTER_WORKGROUP_SIZE: [u32; 3] = [8, 8, 1];
-/// Largest `regions` a variant may have (`PrefilteredVariant::REGIONS`): the projective
-/// frame holds the column invariants of at most 9 region boundaries (`proj_g0..2`).
-pub const MAX_REGIONS: u32 = 8;
 
 /// `depth_columns`: the deepest pixel of every screen row.
 #[derive(Template)]

@@ -14,9 +14,9 @@ pub use frame::{
     ShadowProjectionDesc, SliceParams, prepare_frame, region_start,
 };
 pub use kernels::{
-    DEPTH_COLUMNS_WORKGROUP_SIZE, MAX_REGIONS, PREFILTER_WORKGROUP_SIZE, RECTIFY_TEXELS,
-    RECTIFY_WORKGROUP_SIZE, SCATTER_WORKGROUP_SIZE, SLICE_FIT_WORKGROUP_SIZE,
-    filtered_column_major, filtered_word, filtered_word_bytes,
+    DEPTH_COLUMNS_WORKGROUP_SIZE, PREFILTER_WORKGROUP_SIZE, RECTIFY_TEXELS, RECTIFY_WORKGROUP_SIZE,
+    SCATTER_WORKGROUP_SIZE, SLICE_FIT_WORKGROUP_SIZE, filtered_column_major, filtered_word,
+    filtered_word_bytes,
 };
 pub use variant::{
     Basis, LightKind, PrefilteredVariant, Rectification, Storage, VariantError, VisibilityMode,

@@ -244,7 +244,8 @@ fn filtered_description(v: &PrefilteredVariant) -> &'static str {
         }
         (Basis::Moments, _, true) => {
             concat!(
-                "per colour channel c, the filtered power moments of z = 2 d - 1 times the spot's \
+                "per colour channel c, the filtered power moments of z = (2 d - lo - hi) / max(hi - lo, 0.1) ([lo, hi] the region's depth range, \
+             bounds at its last stored column) times the spot's \
              cookie in layers c * ceil(moments / 4) .., stored as they are; the region's mean \
              cookie (rgb) in the last layer (written by prefilter)",
                 filtered_layout!()
@@ -259,14 +260,16 @@ fn filtered_description(v: &PrefilteredVariant) -> &'static str {
         }
         (Basis::Moments, 6, false) => {
             concat!(
-                "filtered power moments of z = 2 d - 1, (z, z^2, z^3, z^4) in layer 0 and \
+                "filtered power moments of z = (2 d - lo - hi) / max(hi - lo, 0.1) ([lo, hi] the region's depth range, \
+             bounds at its last stored column), (z, z^2, z^3, z^4) in layer 0 and \
              (z^5, z^6, 0, 0) in layer 1, stored as they are (written by prefilter)",
                 filtered_layout!()
             )
         }
         (Basis::Moments, _, false) => {
             concat!(
-                "filtered power moments of z = 2 d - 1, (z, z^2, z^3, z^4), stored as they are \
+                "filtered power moments of z = (2 d - lo - hi) / max(hi - lo, 0.1) ([lo, hi] the region's depth range, \
+             bounds at its last stored column), (z, z^2, z^3, z^4), stored as they are \
              (written by prefilter)",
                 filtered_layout!()
             )

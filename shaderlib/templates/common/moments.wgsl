@@ -5,7 +5,8 @@
 // Klein 2015; 6 moments: a cubic).
 //
 // The math. A region's texels up to a column, weighted, are a distribution of occluder depths
-// z = 2 d - 1 in [-1, 1]; the prefilter stores its power moments b_k = E[z^k], k = 1..2n
+// z in [-1, 1] (`moment_z`: the depth mapped from the region's whole depth range, so that
+// every region's moments use the full interval); the prefilter stores its power moments b_k = E[z^k], k = 1..2n
 // (n = 2 or 3). A ray at depth zf is lit where z >= zf, so the region's visibility is
 // 1 - P(z < zf). Among all distributions with these moments, P(z < zf) is least and greatest
 // for the one with n + 1 atoms, one at zf (the canonical representation): the others are the
@@ -37,9 +38,19 @@ const MOMENT_SPLIT: f32 = 0.5f;
 // A root of the kernel polynomial this far out (in z) is an atom at infinity.
 const FAR_ROOT: f32 = 1e4f;
 
-// The moment coordinate of a normalised depth: z = 2 d - 1.
-fn moment_z(d: f32) -> f32 {
-    return 2.0 * d - 1.0;
+// The least depth range `moment_z` stretches to [-1, 1]: a narrower region's depths fill
+// [-w / MOMENT_RANGE_FLOOR, w / MOMENT_RANGE_FLOOR] of it, so the map's rounding grows at
+// most 20-fold (accuracy as without a floor down to 0.1; see the mirror).
+const MOMENT_RANGE_FLOOR: f32 = 0.1f;
+
+// The moment coordinate of a normalised depth `d` in a region whose depths span
+// `range` = (least, greatest): z = (2 d - least - greatest) / max(greatest - least,
+// MOMENT_RANGE_FLOOR), so the region's depths fill [-1, 1]. With z = 2 d - 1 over the whole
+// map a region's depths filled a fraction of the interval, where the bias below and f32
+// rounding blurred them: 6 moments, 8 regions, mean rel L1 over the 24 suite poses
+// 1.38 -> 1.10 %, window/ordinary 8.01 -> 4.34 % (`prefiltered_truth`, 320x180).
+fn moment_z(d: f32, range: vec2<f32>) -> f32 {
+    return (2.0 * d - (range.x + range.y)) / max(range.y - range.x, MOMENT_RANGE_FLOOR);
 }
 
 // Layer `layer` of the power moments of z: (z, z^2, z^3, z^4) (layer 0) or (z^5, z^6, 0, 0).
