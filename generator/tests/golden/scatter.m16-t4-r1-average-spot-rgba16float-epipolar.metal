@@ -696,9 +696,15 @@ metal::float3 scatter_pixel(
     float total1_ = 0.0;
     bool done0_ = false;
     bool done1_ = false;
+    float prev0_ = 0.0;
+    float prev1_ = 0.0;
     uint r_1 = 0u;
     bool local_2 = {};
     bool local_3 = {};
+    bool local_4 = {};
+    bool local_5 = {};
+    bool local_6 = {};
+    bool local_7 = {};
     float a0_ = {};
     float e0_ = {};
     float a1_ = {};
@@ -707,14 +713,14 @@ metal::float3 scatter_pixel(
     float weight1_ = {};
     float vis0_ = {};
     float vis1_ = {};
-    bool local_4 = {};
-    bool local_5 = {};
-    bool local_6 = {};
-    uint layer_4 = {};
-    uint k_3 = {};
-    bool local_7 = {};
     bool local_8 = {};
     bool local_9 = {};
+    bool local_10 = {};
+    uint layer_4 = {};
+    uint k_3 = {};
+    bool local_11 = {};
+    bool local_12 = {};
+    bool local_13 = {};
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_12 = frame;
     metal::float3 eye_8 = f_12.eye.xyz;
     metal::float3 _e10 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, x_6, y_1);
@@ -809,86 +815,120 @@ metal::float3 scatter_pixel(
     uint last0_ = naga_f2u32(metal::min(metal::max(_e160, 0.0), static_cast<float>(width_1) - 1.0));
     float _e168 = xs1_;
     uint last1_ = naga_f2u32(metal::min(metal::max(_e168, 0.0), static_cast<float>(width_1) - 1.0));
+    float _e176 = xs0_;
+    float cap0_ = metal::floor((metal::floor(_e176 * 1.0) + 1.0) / 1.0);
+    float _e185 = xs1_;
+    float cap1_ = metal::floor((metal::floor(_e185 * 1.0) + 1.0) / 1.0);
     uint2 loop_bound_4 = uint2(4294967295u);
     bool loop_init_4 = true;
     while(true) {
         if (metal::all(loop_bound_4 == uint2(0u))) { break; }
         loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
         if (!loop_init_4) {
-            uint _e467 = r_1;
-            r_1 = _e467 + 1u;
+            uint _e577 = r_1;
+            r_1 = _e577 + 1u;
         }
         loop_init_4 = false;
-        uint _e178 = r_1;
-        if (_e178 < REGIONS) {
+        uint _e196 = r_1;
+        if (_e196 < REGIONS) {
         } else {
             break;
         }
         {
-            uint _e180 = r_1;
-            uint _e181 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e180, REGIONS, width_1, true);
-            float b0_ = static_cast<float>(_e181);
-            uint _e183 = r_1;
-            uint _e186 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e183 + 1u, REGIONS, width_1, true);
-            float b1_ = static_cast<float>(_e186);
+            uint _e198 = r_1;
+            uint _e199 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e198, REGIONS, width_1, true);
+            float b0_ = static_cast<float>(_e199);
+            uint _e201 = r_1;
+            uint _e204 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e201 + 1u, REGIONS, width_1, true);
+            float b1_ = static_cast<float>(_e204);
             if (!((last0_ < naga_f2u32(b1_)))) {
-                uint _e191 = r_1;
-                local_2 = (_e191 + 1u) == REGIONS;
+                uint _e209 = r_1;
+                local_2 = (_e209 + 1u) == REGIONS;
             } else {
                 local_2 = true;
             }
             bool is_last0_ = local_2;
             if (!((last1_ < naga_f2u32(b1_)))) {
-                uint _e202 = r_1;
-                local_3 = (_e202 + 1u) == REGIONS;
+                uint _e220 = r_1;
+                local_3 = (_e220 + 1u) == REGIONS;
             } else {
                 local_3 = true;
             }
             bool is_last1_ = local_3;
-            float _e212 = xs0_;
-            float pos0_ = is_last0_ ? metal::clamp(_e212 - 0.5, b0_ + 0.5, b1_ - 0.5) : (b1_ - 0.5);
-            float _e223 = xs1_;
-            float pos1_ = is_last1_ ? metal::clamp(_e223 - 0.5, b0_ + 0.5, b1_ - 0.5) : (b1_ - 0.5);
+            float _e230 = xs0_;
+            float pos0_ = is_last0_ ? metal::clamp(_e230 - 0.5, b0_ + 0.5, b1_ - 0.5) : (b1_ - 0.5);
+            float _e241 = xs1_;
+            float pos1_ = is_last1_ ? metal::clamp(_e241 - 0.5, b0_ + 0.5, b1_ - 0.5) : (b1_ - 0.5);
+            float _e252 = xs0_;
+            float bb0_ = (is_last0_ ? metal::clamp(metal::min(_e252, cap0_) - 0.5, b0_ + 0.5, b1_ - 0.5) : (b1_ - 0.5)) - 0.5;
+            float _e266 = xs1_;
+            float bb1_ = (is_last1_ ? metal::clamp(metal::min(_e266, cap1_) - 0.5, b0_ + 0.5, b1_ - 0.5) : (b1_ - 0.5)) - 0.5;
+            if (is_last0_) {
+                local_4 = cap0_ <= b0_;
+            } else {
+                local_4 = false;
+            }
+            bool _e282 = local_4;
+            if (_e282) {
+                uint _e283 = r_1;
+                local_5 = _e283 > 0u;
+            } else {
+                local_5 = false;
+            }
+            bool before0_ = local_5;
+            if (is_last1_) {
+                local_6 = cap1_ <= b0_;
+            } else {
+                local_6 = false;
+            }
+            bool _e294 = local_6;
+            if (_e294) {
+                uint _e295 = r_1;
+                local_7 = _e295 > 0u;
+            } else {
+                local_7 = false;
+            }
+            bool before1_ = local_7;
             a0_ = float {};
             e0_ = float {};
             a1_ = float {};
             e1_ = float {};
-            float _e240 = delta0_;
-            float _e241 = theta_3;
-            float _e242 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b0_, _e240, _e241, s_3, true);
-            a0_ = _e242;
-            float _e243 = delta0_;
-            float _e244 = theta_3;
-            float _e245 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b1_, _e243, _e244, s_3, true);
-            e0_ = is_last0_ ? s_3 : _e245;
-            float _e247 = delta1_;
-            float _e248 = theta_3;
-            float _e249 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b0_, _e247, _e248, s_3, true);
-            a1_ = _e249;
-            float _e250 = delta1_;
-            float _e251 = theta_3;
-            float _e252 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b1_, _e250, _e251, s_3, true);
-            e1_ = is_last1_ ? s_3 : _e252;
+            float _e310 = delta0_;
+            float _e311 = theta_3;
+            float _e312 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b0_, _e310, _e311, s_3, true);
+            a0_ = _e312;
+            float _e313 = delta0_;
+            float _e314 = theta_3;
+            float _e315 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b1_, _e313, _e314, s_3, true);
+            e0_ = is_last0_ ? s_3 : _e315;
+            float _e317 = delta1_;
+            float _e318 = theta_3;
+            float _e319 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b0_, _e317, _e318, s_3, true);
+            a1_ = _e319;
+            float _e320 = delta1_;
+            float _e321 = theta_3;
+            float _e322 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b1_, _e320, _e321, s_3, true);
+            e1_ = is_last1_ ? s_3 : _e322;
             weight0_ = float {};
             weight1_ = float {};
             if (true) {
-                float _e258 = a0_;
-                float _e259 = e0_;
-                float _e260 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, _e10, _e258, _e259, panels_2);
-                weight0_ = _e260;
-                float _e261 = a1_;
-                float _e262 = e1_;
-                float _e263 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, _e10, _e261, _e262, panels_2);
-                weight1_ = _e263;
+                float _e328 = a0_;
+                float _e329 = e0_;
+                float _e330 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, _e10, _e328, _e329, panels_2);
+                weight0_ = _e330;
+                float _e331 = a1_;
+                float _e332 = e1_;
+                float _e333 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, _e10, _e331, _e332, panels_2);
+                weight1_ = _e333;
             } else {
-                float _e266 = a0_;
-                float _e267 = e0_;
-                float _e268 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.x, _e266, _e267);
-                weight0_ = sun_scatter * _e268;
-                float _e272 = a1_;
-                float _e273 = e1_;
-                float _e274 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.x, _e272, _e273);
-                weight1_ = sun_scatter * _e274;
+                float _e336 = a0_;
+                float _e337 = e0_;
+                float _e338 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.x, _e336, _e337);
+                weight0_ = sun_scatter * _e338;
+                float _e342 = a1_;
+                float _e343 = e1_;
+                float _e344 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.x, _e342, _e343);
+                weight1_ = sun_scatter * _e344;
             }
             float xb0_ = pos0_ - 0.5;
             float fx0_ = xb0_ - metal::floor(xb0_);
@@ -898,35 +938,37 @@ metal::float3 scatter_pixel(
             float fx1_ = xb1_ - metal::floor(xb1_);
             uint x10_ = naga_f2u32(metal::clamp(metal::floor(xb1_), 0.0, static_cast<float>(width_1) - 1.0));
             uint x11_ = (xb1_ > metal::floor(xb1_)) ? metal::min(x10_ + 1u, width_1 - 1u) : x10_;
-            uint _e314 = bounds_index(x01_, _e78, frame);
-            metal::float2 lohi0_ = bounds[metal::min(unsigned(_e314), (_buffer_sizes.size6 - 0 - 8) / 8)];
-            uint _e318 = bounds_index(x11_, row1_, frame);
-            metal::float2 lohi1_ = bounds[metal::min(unsigned(_e318), (_buffer_sizes.size6 - 0 - 8) / 8)];
+            uint xb00_ = naga_f2u32(metal::clamp(metal::floor(bb0_), 0.0, static_cast<float>(width_1) - 1.0));
+            uint xb10_ = naga_f2u32(metal::clamp(metal::floor(bb1_), 0.0, static_cast<float>(width_1) - 1.0));
+            uint _e406 = bounds_index((bb0_ > metal::floor(bb0_)) ? metal::min(xb00_ + 1u, width_1 - 1u) : xb00_, _e78, frame);
+            metal::float2 lohi0_ = bounds[metal::min(unsigned(_e406), (_buffer_sizes.size6 - 0 - 8) / 8)];
+            uint _e418 = bounds_index((bb1_ > metal::floor(bb1_)) ? metal::min(xb10_ + 1u, width_1 - 1u) : xb10_, row1_, frame);
+            metal::float2 lohi1_ = bounds[metal::min(unsigned(_e418), (_buffer_sizes.size6 - 0 - 8) / 8)];
             vis0_ = 0.5;
             vis1_ = 0.5;
-            float _e326 = d;
-            if (_e326 > lohi0_.x) {
-                float _e329 = d;
-                local_4 = _e329 <= lohi0_.y;
+            float _e426 = d;
+            if (_e426 > lohi0_.x) {
+                float _e429 = d;
+                local_8 = _e429 <= lohi0_.y;
             } else {
-                local_4 = false;
+                local_8 = false;
             }
-            bool _e335 = local_4;
-            if (!(_e335)) {
-                float _e337 = d;
-                if (_e337 > lohi1_.x) {
-                    float _e340 = d;
-                    local_6 = _e340 <= lohi1_.y;
+            bool _e435 = local_8;
+            if (!(_e435)) {
+                float _e437 = d;
+                if (_e437 > lohi1_.x) {
+                    float _e440 = d;
+                    local_10 = _e440 <= lohi1_.y;
                 } else {
-                    local_6 = false;
+                    local_10 = false;
                 }
-                bool _e346 = local_6;
-                local_5 = _e346;
+                bool _e446 = local_10;
+                local_9 = _e446;
             } else {
-                local_5 = true;
+                local_9 = true;
             }
-            bool _e350 = local_5;
-            if (_e350) {
+            bool _e450 = local_9;
+            if (_e450) {
                 layer_4 = 0u;
                 uint2 loop_bound_5 = uint2(4294967295u);
                 bool loop_init_5 = true;
@@ -934,28 +976,28 @@ metal::float3 scatter_pixel(
                     if (metal::all(loop_bound_5 == uint2(0u))) { break; }
                     loop_bound_5 -= uint2(loop_bound_5.y == 0u, 1u);
                     if (!loop_init_5) {
-                        uint _e400 = layer_4;
-                        layer_4 = _e400 + 1u;
+                        uint _e500 = layer_4;
+                        layer_4 = _e500 + 1u;
                     }
                     loop_init_5 = false;
-                    uint _e353 = layer_4;
-                    if (_e353 < LAYERS) {
+                    uint _e453 = layer_4;
+                    if (_e453 < LAYERS) {
                     } else {
                         break;
                     }
                     {
-                        uint _e356 = layer_4;
-                        metal::float4 coeff = coeffs.inner[metal::min(unsigned(_e356), 3u)];
-                        uint _e359 = layer_4;
-                        metal::float4 _e360 = filtered_load(x00_, _e78, _e359, frame, filtered, _buffer_sizes);
-                        uint _e361 = layer_4;
-                        metal::float4 _e362 = filtered_load(x01_, _e78, _e361, frame, filtered, _buffer_sizes);
-                        metal::float4 texel0_ = metal::mix(_e360, _e362, fx0_);
-                        uint _e364 = layer_4;
-                        metal::float4 _e365 = filtered_load(x10_, row1_, _e364, frame, filtered, _buffer_sizes);
-                        uint _e366 = layer_4;
-                        metal::float4 _e367 = filtered_load(x11_, row1_, _e366, frame, filtered, _buffer_sizes);
-                        metal::float4 texel1_ = metal::mix(_e365, _e367, fx1_);
+                        uint _e456 = layer_4;
+                        metal::float4 coeff = coeffs.inner[metal::min(unsigned(_e456), 3u)];
+                        uint _e459 = layer_4;
+                        metal::float4 _e460 = filtered_load(x00_, _e78, _e459, frame, filtered, _buffer_sizes);
+                        uint _e461 = layer_4;
+                        metal::float4 _e462 = filtered_load(x01_, _e78, _e461, frame, filtered, _buffer_sizes);
+                        metal::float4 texel0_ = metal::mix(_e460, _e462, fx0_);
+                        uint _e464 = layer_4;
+                        metal::float4 _e465 = filtered_load(x10_, row1_, _e464, frame, filtered, _buffer_sizes);
+                        uint _e466 = layer_4;
+                        metal::float4 _e467 = filtered_load(x11_, row1_, _e466, frame, filtered, _buffer_sizes);
+                        metal::float4 texel1_ = metal::mix(_e465, _e467, fx1_);
                         k_3 = 0u;
                         uint2 loop_bound_6 = uint2(4294967295u);
                         bool loop_init_6 = true;
@@ -963,83 +1005,93 @@ metal::float3 scatter_pixel(
                             if (metal::all(loop_bound_6 == uint2(0u))) { break; }
                             loop_bound_6 -= uint2(loop_bound_6.y == 0u, 1u);
                             if (!loop_init_6) {
-                                uint _e397 = k_3;
-                                k_3 = _e397 + 1u;
+                                uint _e497 = k_3;
+                                k_3 = _e497 + 1u;
                             }
                             loop_init_6 = false;
-                            uint _e371 = k_3;
-                            if (_e371 < 4u) {
+                            uint _e471 = k_3;
+                            if (_e471 < 4u) {
                             } else {
                                 break;
                             }
                             {
-                                float _e374 = vis0_;
-                                uint _e375 = k_3;
-                                uint _e377 = k_3;
-                                vis0_ = _e374 + (coeff[metal::min(unsigned(_e375), 3u)] * ((texel0_[metal::min(unsigned(_e377), 3u)] * 2.0) - 1.0));
-                                float _e385 = vis1_;
-                                uint _e386 = k_3;
-                                uint _e388 = k_3;
-                                vis1_ = _e385 + (coeff[metal::min(unsigned(_e386), 3u)] * ((texel1_[metal::min(unsigned(_e388), 3u)] * 2.0) - 1.0));
+                                float _e474 = vis0_;
+                                uint _e475 = k_3;
+                                uint _e477 = k_3;
+                                vis0_ = _e474 + (coeff[metal::min(unsigned(_e475), 3u)] * ((texel0_[metal::min(unsigned(_e477), 3u)] * 2.0) - 1.0));
+                                float _e485 = vis1_;
+                                uint _e486 = k_3;
+                                uint _e488 = k_3;
+                                vis1_ = _e485 + (coeff[metal::min(unsigned(_e486), 3u)] * ((texel1_[metal::min(unsigned(_e488), 3u)] * 2.0) - 1.0));
                             }
                         }
                     }
                 }
             }
-            float _e402 = vis0_;
-            float _e403 = d;
-            float _e408 = d;
-            vis0_ = (_e408 <= lohi0_.x) ? 1.0 : ((_e403 > lohi0_.y) ? 0.0 : _e402);
-            float _e413 = vis1_;
-            float _e414 = d;
-            float _e419 = d;
-            vis1_ = (_e419 <= lohi1_.x) ? 1.0 : ((_e414 > lohi1_.y) ? 0.0 : _e413);
-            bool _e425 = done0_;
-            if (!(_e425)) {
-                float _e428 = total0_;
-                float _e429 = weight0_;
-                float _e430 = vis0_;
-                total0_ = _e428 + (_e429 * metal::clamp(_e430, 0.0, 1.0));
+            float _e502 = vis0_;
+            float _e503 = d;
+            float _e508 = d;
+            vis0_ = (_e508 <= lohi0_.x) ? 1.0 : ((_e503 > lohi0_.y) ? 0.0 : _e502);
+            float _e513 = vis1_;
+            float _e514 = d;
+            float _e519 = d;
+            vis1_ = (_e519 <= lohi1_.x) ? 1.0 : ((_e514 > lohi1_.y) ? 0.0 : _e513);
+            float _e524 = vis0_;
+            float _e529 = prev0_;
+            vis0_ = before0_ ? _e529 : metal::clamp(_e524, 0.0, 1.0);
+            float _e531 = vis1_;
+            float _e536 = prev1_;
+            vis1_ = before1_ ? _e536 : metal::clamp(_e531, 0.0, 1.0);
+            float _e538 = vis0_;
+            prev0_ = _e538;
+            float _e539 = vis1_;
+            prev1_ = _e539;
+            bool _e541 = done0_;
+            if (!(_e541)) {
+                float _e544 = total0_;
+                float _e545 = weight0_;
+                float _e546 = vis0_;
+                total0_ = _e544 + (_e545 * _e546);
             }
-            bool _e437 = done1_;
-            if (!(_e437)) {
-                float _e440 = total1_;
-                float _e441 = weight1_;
-                float _e442 = vis1_;
-                total1_ = _e440 + (_e441 * metal::clamp(_e442, 0.0, 1.0));
+            bool _e550 = done1_;
+            if (!(_e550)) {
+                float _e553 = total1_;
+                float _e554 = weight1_;
+                float _e555 = vis1_;
+                total1_ = _e553 + (_e554 * _e555);
             }
-            bool _e448 = done0_;
-            if (!(_e448)) {
-                local_7 = is_last0_;
+            bool _e558 = done0_;
+            if (!(_e558)) {
+                local_11 = is_last0_;
             } else {
-                local_7 = true;
+                local_11 = true;
             }
-            bool _e453 = local_7;
-            done0_ = _e453;
-            bool _e454 = done1_;
-            if (!(_e454)) {
-                local_8 = is_last1_;
+            bool _e563 = local_11;
+            done0_ = _e563;
+            bool _e564 = done1_;
+            if (!(_e564)) {
+                local_12 = is_last1_;
             } else {
-                local_8 = true;
+                local_12 = true;
             }
-            bool _e459 = local_8;
-            done1_ = _e459;
-            bool _e460 = done0_;
-            if (_e460) {
-                bool _e461 = done1_;
-                local_9 = _e461;
+            bool _e569 = local_12;
+            done1_ = _e569;
+            bool _e570 = done0_;
+            if (_e570) {
+                bool _e571 = done1_;
+                local_13 = _e571;
             } else {
-                local_9 = false;
+                local_13 = false;
             }
-            bool _e465 = local_9;
-            if (_e465) {
+            bool _e575 = local_13;
+            if (_e575) {
                 break;
             }
         }
     }
-    float _e471 = total0_;
-    float _e473 = total1_;
-    float l_2 = ((1.0 - w1_) * _e471) + (w1_ * _e473);
+    float _e581 = total0_;
+    float _e583 = total1_;
+    float l_2 = ((1.0 - w1_) * _e581) + (w1_ * _e583);
     metal::float3 c = color * l_2;
     return c;
 }

@@ -475,9 +475,15 @@ fn scatter_pixel(x_6: u32, y_1: u32) -> vec3<f32> {
     var total1_: f32 = 0f;
     var done0_: bool = false;
     var done1_: bool = false;
+    var prev0_: f32 = 0f;
+    var prev1_: f32 = 0f;
     var r_1: u32 = 0u;
     var local_2: bool;
     var local_3: bool;
+    var local_4: bool;
+    var local_5: bool;
+    var local_6: bool;
+    var local_7: bool;
     var a0_: f32;
     var e0_: f32;
     var a1_: f32;
@@ -486,14 +492,14 @@ fn scatter_pixel(x_6: u32, y_1: u32) -> vec3<f32> {
     var weight1_: f32;
     var vis0_: f32;
     var vis1_: f32;
-    var local_4: bool;
-    var local_5: bool;
-    var local_6: bool;
-    var layer_4: u32;
-    var k_3: u32;
-    var local_7: bool;
     var local_8: bool;
     var local_9: bool;
+    var local_10: bool;
+    var layer_4: u32;
+    var k_3: u32;
+    var local_11: bool;
+    var local_12: bool;
+    var local_13: bool;
 
     let f_12 = frame;
     let eye_8 = f_12.eye.xyz;
@@ -583,77 +589,111 @@ fn scatter_pixel(x_6: u32, y_1: u32) -> vec3<f32> {
     let last0_ = u32(min(max(_e160, 0f), (f32(width_1) - 1f)));
     let _e168 = xs1_;
     let last1_ = u32(min(max(_e168, 0f), (f32(width_1) - 1f)));
+    let _e176 = xs0_;
+    let cap0_ = floor(((floor((_e176 * 1f)) + 1f) / 1f));
+    let _e185 = xs1_;
+    let cap1_ = floor(((floor((_e185 * 1f)) + 1f) / 1f));
     loop {
-        let _e178 = r_1;
-        if (_e178 < REGIONS) {
+        let _e196 = r_1;
+        if (_e196 < REGIONS) {
         } else {
             break;
         }
         {
-            let _e180 = r_1;
-            let _e181 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e180, REGIONS, width_1, false);
-            let b0_ = f32(_e181);
-            let _e183 = r_1;
-            let _e186 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e183 + 1u), REGIONS, width_1, false);
-            let b1_ = f32(_e186);
+            let _e198 = r_1;
+            let _e199 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e198, REGIONS, width_1, false);
+            let b0_ = f32(_e199);
+            let _e201 = r_1;
+            let _e204 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e201 + 1u), REGIONS, width_1, false);
+            let b1_ = f32(_e204);
             if !((last0_ < u32(b1_))) {
-                let _e191 = r_1;
-                local_2 = ((_e191 + 1u) == REGIONS);
+                let _e209 = r_1;
+                local_2 = ((_e209 + 1u) == REGIONS);
             } else {
                 local_2 = true;
             }
             let is_last0_ = local_2;
             if !((last1_ < u32(b1_))) {
-                let _e202 = r_1;
-                local_3 = ((_e202 + 1u) == REGIONS);
+                let _e220 = r_1;
+                local_3 = ((_e220 + 1u) == REGIONS);
             } else {
                 local_3 = true;
             }
             let is_last1_ = local_3;
-            let _e212 = xs0_;
-            let pos0_ = select((b1_ - 0.5f), clamp((_e212 - 0.5f), (b0_ + 0.5f), (b1_ - 0.5f)), is_last0_);
-            let _e223 = xs1_;
-            let pos1_ = select((b1_ - 0.5f), clamp((_e223 - 0.5f), (b0_ + 0.5f), (b1_ - 0.5f)), is_last1_);
+            let _e230 = xs0_;
+            let pos0_ = select((b1_ - 0.5f), clamp((_e230 - 0.5f), (b0_ + 0.5f), (b1_ - 0.5f)), is_last0_);
+            let _e241 = xs1_;
+            let pos1_ = select((b1_ - 0.5f), clamp((_e241 - 0.5f), (b0_ + 0.5f), (b1_ - 0.5f)), is_last1_);
+            let _e252 = xs0_;
+            let bb0_ = (select((b1_ - 0.5f), clamp((min(_e252, cap0_) - 0.5f), (b0_ + 0.5f), (b1_ - 0.5f)), is_last0_) - 0.5f);
+            let _e266 = xs1_;
+            let bb1_ = (select((b1_ - 0.5f), clamp((min(_e266, cap1_) - 0.5f), (b0_ + 0.5f), (b1_ - 0.5f)), is_last1_) - 0.5f);
+            if is_last0_ {
+                local_4 = (cap0_ <= b0_);
+            } else {
+                local_4 = false;
+            }
+            let _e282 = local_4;
+            if _e282 {
+                let _e283 = r_1;
+                local_5 = (_e283 > 0u);
+            } else {
+                local_5 = false;
+            }
+            let before0_ = local_5;
+            if is_last1_ {
+                local_6 = (cap1_ <= b0_);
+            } else {
+                local_6 = false;
+            }
+            let _e294 = local_6;
+            if _e294 {
+                let _e295 = r_1;
+                local_7 = (_e295 > 0u);
+            } else {
+                local_7 = false;
+            }
+            let before1_ = local_7;
             a0_ = f32();
             e0_ = f32();
             a1_ = f32();
             e1_ = f32();
-            let _e240 = delta0_;
-            let _e241 = theta_3;
-            let _e242 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b0_, _e240, _e241, s_3, false);
-            a0_ = _e242;
-            let _e243 = delta0_;
-            let _e244 = theta_3;
-            let _e245 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b1_, _e243, _e244, s_3, false);
-            e0_ = select(_e245, s_3, is_last0_);
-            let _e247 = delta1_;
-            let _e248 = theta_3;
-            let _e249 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b0_, _e247, _e248, s_3, false);
-            a1_ = _e249;
-            let _e250 = delta1_;
-            let _e251 = theta_3;
-            let _e252 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b1_, _e250, _e251, s_3, false);
-            e1_ = select(_e252, s_3, is_last1_);
+            let _e310 = delta0_;
+            let _e311 = theta_3;
+            let _e312 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b0_, _e310, _e311, s_3, false);
+            a0_ = _e312;
+            let _e313 = delta0_;
+            let _e314 = theta_3;
+            let _e315 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b1_, _e313, _e314, s_3, false);
+            e0_ = select(_e315, s_3, is_last0_);
+            let _e317 = delta1_;
+            let _e318 = theta_3;
+            let _e319 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b0_, _e317, _e318, s_3, false);
+            a1_ = _e319;
+            let _e320 = delta1_;
+            let _e321 = theta_3;
+            let _e322 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b1_, _e320, _e321, s_3, false);
+            e1_ = select(_e322, s_3, is_last1_);
             weight0_ = f32();
             weight1_ = f32();
             if false {
-                let _e258 = a0_;
-                let _e259 = e0_;
-                let _e260 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, _e10, _e258, _e259, panels_2);
-                weight0_ = _e260;
-                let _e261 = a1_;
-                let _e262 = e1_;
-                let _e263 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, _e10, _e261, _e262, panels_2);
-                weight1_ = _e263;
+                let _e328 = a0_;
+                let _e329 = e0_;
+                let _e330 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, _e10, _e328, _e329, panels_2);
+                weight0_ = _e330;
+                let _e331 = a1_;
+                let _e332 = e1_;
+                let _e333 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, _e10, _e331, _e332, panels_2);
+                weight1_ = _e333;
             } else {
-                let _e266 = a0_;
-                let _e267 = e0_;
-                let _e268 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.x, _e266, _e267);
-                weight0_ = (sun_scatter * _e268);
-                let _e272 = a1_;
-                let _e273 = e1_;
-                let _e274 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.x, _e272, _e273);
-                weight1_ = (sun_scatter * _e274);
+                let _e336 = a0_;
+                let _e337 = e0_;
+                let _e338 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.x, _e336, _e337);
+                weight0_ = (sun_scatter * _e338);
+                let _e342 = a1_;
+                let _e343 = e1_;
+                let _e344 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.x, _e342, _e343);
+                weight1_ = (sun_scatter * _e344);
             }
             let xb0_ = (pos0_ - 0.5f);
             let fx0_ = (xb0_ - floor(xb0_));
@@ -663,142 +703,154 @@ fn scatter_pixel(x_6: u32, y_1: u32) -> vec3<f32> {
             let fx1_ = (xb1_ - floor(xb1_));
             let x10_ = u32(clamp(floor(xb1_), 0f, (f32(width_1) - 1f)));
             let x11_ = select(x10_, min((x10_ + 1u), (width_1 - 1u)), (xb1_ > floor(xb1_)));
-            let _e314 = bounds_index(x01_, _e78);
-            let lohi0_ = bounds[_e314];
-            let _e318 = bounds_index(x11_, row1_);
-            let lohi1_ = bounds[_e318];
+            let xb00_ = u32(clamp(floor(bb0_), 0f, (f32(width_1) - 1f)));
+            let xb10_ = u32(clamp(floor(bb1_), 0f, (f32(width_1) - 1f)));
+            let _e406 = bounds_index(select(xb00_, min((xb00_ + 1u), (width_1 - 1u)), (bb0_ > floor(bb0_))), _e78);
+            let lohi0_ = bounds[_e406];
+            let _e418 = bounds_index(select(xb10_, min((xb10_ + 1u), (width_1 - 1u)), (bb1_ > floor(bb1_))), row1_);
+            let lohi1_ = bounds[_e418];
             vis0_ = 0.5f;
             vis1_ = 0.5f;
-            let _e326 = d;
-            if (_e326 > lohi0_.x) {
-                let _e329 = d;
-                local_4 = (_e329 <= lohi0_.y);
+            let _e426 = d;
+            if (_e426 > lohi0_.x) {
+                let _e429 = d;
+                local_8 = (_e429 <= lohi0_.y);
             } else {
-                local_4 = false;
+                local_8 = false;
             }
-            let _e335 = local_4;
-            if !(_e335) {
-                let _e337 = d;
-                if (_e337 > lohi1_.x) {
-                    let _e340 = d;
-                    local_6 = (_e340 <= lohi1_.y);
+            let _e435 = local_8;
+            if !(_e435) {
+                let _e437 = d;
+                if (_e437 > lohi1_.x) {
+                    let _e440 = d;
+                    local_10 = (_e440 <= lohi1_.y);
                 } else {
-                    local_6 = false;
+                    local_10 = false;
                 }
-                let _e346 = local_6;
-                local_5 = _e346;
+                let _e446 = local_10;
+                local_9 = _e446;
             } else {
-                local_5 = true;
+                local_9 = true;
             }
-            let _e350 = local_5;
-            if _e350 {
+            let _e450 = local_9;
+            if _e450 {
                 layer_4 = 0u;
                 loop {
-                    let _e353 = layer_4;
-                    if (_e353 < LAYERS) {
+                    let _e453 = layer_4;
+                    if (_e453 < LAYERS) {
                     } else {
                         break;
                     }
                     {
-                        let _e356 = layer_4;
-                        let coeff = coeffs[_e356];
-                        let _e359 = layer_4;
-                        let _e360 = filtered_load(x00_, _e78, _e359);
-                        let _e361 = layer_4;
-                        let _e362 = filtered_load(x01_, _e78, _e361);
-                        let texel0_ = mix(_e360, _e362, fx0_);
-                        let _e364 = layer_4;
-                        let _e365 = filtered_load(x10_, row1_, _e364);
-                        let _e366 = layer_4;
-                        let _e367 = filtered_load(x11_, row1_, _e366);
-                        let texel1_ = mix(_e365, _e367, fx1_);
+                        let _e456 = layer_4;
+                        let coeff = coeffs[_e456];
+                        let _e459 = layer_4;
+                        let _e460 = filtered_load(x00_, _e78, _e459);
+                        let _e461 = layer_4;
+                        let _e462 = filtered_load(x01_, _e78, _e461);
+                        let texel0_ = mix(_e460, _e462, fx0_);
+                        let _e464 = layer_4;
+                        let _e465 = filtered_load(x10_, row1_, _e464);
+                        let _e466 = layer_4;
+                        let _e467 = filtered_load(x11_, row1_, _e466);
+                        let texel1_ = mix(_e465, _e467, fx1_);
                         k_3 = 0u;
                         loop {
-                            let _e371 = k_3;
-                            if (_e371 < 4u) {
+                            let _e471 = k_3;
+                            if (_e471 < 4u) {
                             } else {
                                 break;
                             }
                             {
-                                let _e374 = vis0_;
-                                let _e375 = k_3;
-                                let _e377 = k_3;
-                                vis0_ = (_e374 + (coeff[_e375] * ((texel0_[_e377] * 2f) - 1f)));
-                                let _e385 = vis1_;
-                                let _e386 = k_3;
-                                let _e388 = k_3;
-                                vis1_ = (_e385 + (coeff[_e386] * ((texel1_[_e388] * 2f) - 1f)));
+                                let _e474 = vis0_;
+                                let _e475 = k_3;
+                                let _e477 = k_3;
+                                vis0_ = (_e474 + (coeff[_e475] * ((texel0_[_e477] * 2f) - 1f)));
+                                let _e485 = vis1_;
+                                let _e486 = k_3;
+                                let _e488 = k_3;
+                                vis1_ = (_e485 + (coeff[_e486] * ((texel1_[_e488] * 2f) - 1f)));
                             }
                             continuing {
-                                let _e397 = k_3;
-                                k_3 = (_e397 + 1u);
+                                let _e497 = k_3;
+                                k_3 = (_e497 + 1u);
                             }
                         }
                     }
                     continuing {
-                        let _e400 = layer_4;
-                        layer_4 = (_e400 + 1u);
+                        let _e500 = layer_4;
+                        layer_4 = (_e500 + 1u);
                     }
                 }
             }
-            let _e402 = vis0_;
-            let _e403 = d;
-            let _e408 = d;
-            vis0_ = select(select(_e402, 0f, (_e403 > lohi0_.y)), 1f, (_e408 <= lohi0_.x));
-            let _e413 = vis1_;
-            let _e414 = d;
-            let _e419 = d;
-            vis1_ = select(select(_e413, 0f, (_e414 > lohi1_.y)), 1f, (_e419 <= lohi1_.x));
-            let _e425 = done0_;
-            if !(_e425) {
-                let _e428 = total0_;
-                let _e429 = weight0_;
-                let _e430 = vis0_;
-                total0_ = (_e428 + (_e429 * clamp(_e430, 0f, 1f)));
+            let _e502 = vis0_;
+            let _e503 = d;
+            let _e508 = d;
+            vis0_ = select(select(_e502, 0f, (_e503 > lohi0_.y)), 1f, (_e508 <= lohi0_.x));
+            let _e513 = vis1_;
+            let _e514 = d;
+            let _e519 = d;
+            vis1_ = select(select(_e513, 0f, (_e514 > lohi1_.y)), 1f, (_e519 <= lohi1_.x));
+            let _e524 = vis0_;
+            let _e529 = prev0_;
+            vis0_ = select(clamp(_e524, 0f, 1f), _e529, before0_);
+            let _e531 = vis1_;
+            let _e536 = prev1_;
+            vis1_ = select(clamp(_e531, 0f, 1f), _e536, before1_);
+            let _e538 = vis0_;
+            prev0_ = _e538;
+            let _e539 = vis1_;
+            prev1_ = _e539;
+            let _e541 = done0_;
+            if !(_e541) {
+                let _e544 = total0_;
+                let _e545 = weight0_;
+                let _e546 = vis0_;
+                total0_ = (_e544 + (_e545 * _e546));
             }
-            let _e437 = done1_;
-            if !(_e437) {
-                let _e440 = total1_;
-                let _e441 = weight1_;
-                let _e442 = vis1_;
-                total1_ = (_e440 + (_e441 * clamp(_e442, 0f, 1f)));
+            let _e550 = done1_;
+            if !(_e550) {
+                let _e553 = total1_;
+                let _e554 = weight1_;
+                let _e555 = vis1_;
+                total1_ = (_e553 + (_e554 * _e555));
             }
-            let _e448 = done0_;
-            if !(_e448) {
-                local_7 = is_last0_;
+            let _e558 = done0_;
+            if !(_e558) {
+                local_11 = is_last0_;
             } else {
-                local_7 = true;
+                local_11 = true;
             }
-            let _e453 = local_7;
-            done0_ = _e453;
-            let _e454 = done1_;
-            if !(_e454) {
-                local_8 = is_last1_;
+            let _e563 = local_11;
+            done0_ = _e563;
+            let _e564 = done1_;
+            if !(_e564) {
+                local_12 = is_last1_;
             } else {
-                local_8 = true;
+                local_12 = true;
             }
-            let _e459 = local_8;
-            done1_ = _e459;
-            let _e460 = done0_;
-            if _e460 {
-                let _e461 = done1_;
-                local_9 = _e461;
+            let _e569 = local_12;
+            done1_ = _e569;
+            let _e570 = done0_;
+            if _e570 {
+                let _e571 = done1_;
+                local_13 = _e571;
             } else {
-                local_9 = false;
+                local_13 = false;
             }
-            let _e465 = local_9;
-            if _e465 {
+            let _e575 = local_13;
+            if _e575 {
                 break;
             }
         }
         continuing {
-            let _e467 = r_1;
-            r_1 = (_e467 + 1u);
+            let _e577 = r_1;
+            r_1 = (_e577 + 1u);
         }
     }
-    let _e471 = total0_;
-    let _e473 = total1_;
-    let l_2 = (((1f - w1_) * _e471) + (w1_ * _e473));
+    let _e581 = total0_;
+    let _e583 = total1_;
+    let l_2 = (((1f - w1_) * _e581) + (w1_ * _e583));
     let c = (color * l_2);
     return c;
 }

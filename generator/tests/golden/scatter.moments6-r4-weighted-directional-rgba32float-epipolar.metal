@@ -845,9 +845,15 @@ metal::float3 scatter_pixel(
     float total1_ = 0.0;
     bool done0_ = false;
     bool done1_ = false;
+    float prev0_ = 0.0;
+    float prev1_ = 0.0;
     uint r_1 = 0u;
     bool local_3 = {};
     bool local_4 = {};
+    bool local_5 = {};
+    bool local_6 = {};
+    bool local_7 = {};
+    bool local_8 = {};
     float a0_ = {};
     float e0_ = {};
     float a1_ = {};
@@ -856,11 +862,11 @@ metal::float3 scatter_pixel(
     float weight1_ = {};
     float vis0_ = {};
     float vis1_ = {};
-    bool local_5 = {};
-    bool local_6 = {};
-    bool local_7 = {};
-    bool local_8 = {};
     bool local_9 = {};
+    bool local_10 = {};
+    bool local_11 = {};
+    bool local_12 = {};
+    bool local_13 = {};
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_13 = frame;
     metal::float3 eye_8 = f_13.eye.xyz;
     metal::float3 _e10 = pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, x_9, y_1);
@@ -923,86 +929,120 @@ metal::float3 scatter_pixel(
     uint last0_ = naga_f2u32(metal::min(metal::max(_e132, 0.0), static_cast<float>(width_1) - 1.0));
     float _e140 = xs1_;
     uint last1_ = naga_f2u32(metal::min(metal::max(_e140, 0.0), static_cast<float>(width_1) - 1.0));
+    float _e148 = xs0_;
+    float cap0_ = metal::floor((metal::floor(_e148 * 1.0) + 1.0) / 1.0);
+    float _e157 = xs1_;
+    float cap1_ = metal::floor((metal::floor(_e157 * 1.0) + 1.0) / 1.0);
     uint2 loop_bound_4 = uint2(4294967295u);
     bool loop_init_4 = true;
     while(true) {
         if (metal::all(loop_bound_4 == uint2(0u))) { break; }
         loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
         if (!loop_init_4) {
-            uint _e425 = r_1;
-            r_1 = _e425 + 1u;
+            uint _e535 = r_1;
+            r_1 = _e535 + 1u;
         }
         loop_init_4 = false;
-        uint _e150 = r_1;
-        if (_e150 < REGIONS) {
+        uint _e168 = r_1;
+        if (_e168 < REGIONS) {
         } else {
             break;
         }
         {
-            uint _e152 = r_1;
-            uint _e153 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e152, REGIONS, width_1, false);
-            float b0_ = static_cast<float>(_e153);
-            uint _e155 = r_1;
-            uint _e158 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e155 + 1u, REGIONS, width_1, false);
-            float b1_2 = static_cast<float>(_e158);
+            uint _e170 = r_1;
+            uint _e171 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e170, REGIONS, width_1, false);
+            float b0_ = static_cast<float>(_e171);
+            uint _e173 = r_1;
+            uint _e176 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e173 + 1u, REGIONS, width_1, false);
+            float b1_2 = static_cast<float>(_e176);
             if (!((last0_ < naga_f2u32(b1_2)))) {
-                uint _e163 = r_1;
-                local_3 = (_e163 + 1u) == REGIONS;
+                uint _e181 = r_1;
+                local_3 = (_e181 + 1u) == REGIONS;
             } else {
                 local_3 = true;
             }
             bool is_last0_ = local_3;
             if (!((last1_ < naga_f2u32(b1_2)))) {
-                uint _e174 = r_1;
-                local_4 = (_e174 + 1u) == REGIONS;
+                uint _e192 = r_1;
+                local_4 = (_e192 + 1u) == REGIONS;
             } else {
                 local_4 = true;
             }
             bool is_last1_ = local_4;
-            float _e184 = xs0_;
-            float pos0_ = is_last0_ ? metal::clamp(_e184 - 0.5, b0_ + 0.5, b1_2 - 0.5) : (b1_2 - 0.5);
-            float _e195 = xs1_;
-            float pos1_ = is_last1_ ? metal::clamp(_e195 - 0.5, b0_ + 0.5, b1_2 - 0.5) : (b1_2 - 0.5);
+            float _e202 = xs0_;
+            float pos0_ = is_last0_ ? metal::clamp(_e202 - 0.5, b0_ + 0.5, b1_2 - 0.5) : (b1_2 - 0.5);
+            float _e213 = xs1_;
+            float pos1_ = is_last1_ ? metal::clamp(_e213 - 0.5, b0_ + 0.5, b1_2 - 0.5) : (b1_2 - 0.5);
+            float _e224 = xs0_;
+            float bb0_ = (is_last0_ ? metal::clamp(metal::min(_e224, cap0_) - 0.5, b0_ + 0.5, b1_2 - 0.5) : (b1_2 - 0.5)) - 0.5;
+            float _e238 = xs1_;
+            float bb1_ = (is_last1_ ? metal::clamp(metal::min(_e238, cap1_) - 0.5, b0_ + 0.5, b1_2 - 0.5) : (b1_2 - 0.5)) - 0.5;
+            if (is_last0_) {
+                local_5 = cap0_ <= b0_;
+            } else {
+                local_5 = false;
+            }
+            bool _e254 = local_5;
+            if (_e254) {
+                uint _e255 = r_1;
+                local_6 = _e255 > 0u;
+            } else {
+                local_6 = false;
+            }
+            bool before0_ = local_6;
+            if (is_last1_) {
+                local_7 = cap1_ <= b0_;
+            } else {
+                local_7 = false;
+            }
+            bool _e266 = local_7;
+            if (_e266) {
+                uint _e267 = r_1;
+                local_8 = _e267 > 0u;
+            } else {
+                local_8 = false;
+            }
+            bool before1_ = local_8;
             a0_ = float {};
             e0_ = float {};
             a1_ = float {};
             e1_ = float {};
-            float _e212 = delta0_;
-            float _e213 = theta_3;
-            float _e214 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b0_, _e212, _e213, s_5, false);
-            a0_ = _e214;
-            float _e215 = delta0_;
-            float _e216 = theta_3;
-            float _e217 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b1_2, _e215, _e216, s_5, false);
-            e0_ = is_last0_ ? s_5 : _e217;
-            float _e219 = delta1_;
-            float _e220 = theta_3;
-            float _e221 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b0_, _e219, _e220, s_5, false);
-            a1_ = _e221;
-            float _e222 = delta1_;
-            float _e223 = theta_3;
-            float _e224 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b1_2, _e222, _e223, s_5, false);
-            e1_ = is_last1_ ? s_5 : _e224;
+            float _e282 = delta0_;
+            float _e283 = theta_3;
+            float _e284 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b0_, _e282, _e283, s_5, false);
+            a0_ = _e284;
+            float _e285 = delta0_;
+            float _e286 = theta_3;
+            float _e287 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b1_2, _e285, _e286, s_5, false);
+            e0_ = is_last0_ ? s_5 : _e287;
+            float _e289 = delta1_;
+            float _e290 = theta_3;
+            float _e291 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b0_, _e289, _e290, s_5, false);
+            a1_ = _e291;
+            float _e292 = delta1_;
+            float _e293 = theta_3;
+            float _e294 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b1_2, _e292, _e293, s_5, false);
+            e1_ = is_last1_ ? s_5 : _e294;
             weight0_ = float {};
             weight1_ = float {};
             if (false) {
-                float _e230 = a0_;
-                float _e231 = e0_;
-                float _e232 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, _e10, _e230, _e231, panels_2);
-                weight0_ = _e232;
-                float _e233 = a1_;
-                float _e234 = e1_;
-                float _e235 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, _e10, _e233, _e234, panels_2);
-                weight1_ = _e235;
+                float _e300 = a0_;
+                float _e301 = e0_;
+                float _e302 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, _e10, _e300, _e301, panels_2);
+                weight0_ = _e302;
+                float _e303 = a1_;
+                float _e304 = e1_;
+                float _e305 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, _e10, _e303, _e304, panels_2);
+                weight1_ = _e305;
             } else {
-                float _e238 = a0_;
-                float _e239 = e0_;
-                float _e240 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.x, _e238, _e239);
-                weight0_ = sun_scatter * _e240;
-                float _e244 = a1_;
-                float _e245 = e1_;
-                float _e246 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.x, _e244, _e245);
-                weight1_ = sun_scatter * _e246;
+                float _e308 = a0_;
+                float _e309 = e0_;
+                float _e310 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.x, _e308, _e309);
+                weight0_ = sun_scatter * _e310;
+                float _e314 = a1_;
+                float _e315 = e1_;
+                float _e316 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.x, _e314, _e315);
+                weight1_ = sun_scatter * _e316;
             }
             float xb0_ = pos0_ - 0.5;
             float fx0_ = xb0_ - metal::floor(xb0_);
@@ -1012,110 +1052,122 @@ metal::float3 scatter_pixel(
             float fx1_ = xb1_ - metal::floor(xb1_);
             uint x10_ = naga_f2u32(metal::clamp(metal::floor(xb1_), 0.0, static_cast<float>(width_1) - 1.0));
             uint x11_ = (xb1_ > metal::floor(xb1_)) ? metal::min(x10_ + 1u, width_1 - 1u) : x10_;
-            uint _e286 = bounds_index(x01_, _e78, frame);
-            metal::float2 lohi0_ = bounds[metal::min(unsigned(_e286), (_buffer_sizes.size6 - 0 - 8) / 8)];
-            uint _e290 = bounds_index(x11_, row1_, frame);
-            metal::float2 lohi1_ = bounds[metal::min(unsigned(_e290), (_buffer_sizes.size6 - 0 - 8) / 8)];
+            uint xb00_ = naga_f2u32(metal::clamp(metal::floor(bb0_), 0.0, static_cast<float>(width_1) - 1.0));
+            uint xb10_ = naga_f2u32(metal::clamp(metal::floor(bb1_), 0.0, static_cast<float>(width_1) - 1.0));
+            uint _e378 = bounds_index((bb0_ > metal::floor(bb0_)) ? metal::min(xb00_ + 1u, width_1 - 1u) : xb00_, _e78, frame);
+            metal::float2 lohi0_ = bounds[metal::min(unsigned(_e378), (_buffer_sizes.size6 - 0 - 8) / 8)];
+            uint _e390 = bounds_index((bb1_ > metal::floor(bb1_)) ? metal::min(xb10_ + 1u, width_1 - 1u) : xb10_, row1_, frame);
+            metal::float2 lohi1_ = bounds[metal::min(unsigned(_e390), (_buffer_sizes.size6 - 0 - 8) / 8)];
             vis0_ = 0.5;
             vis1_ = 0.5;
-            float _e298 = d_1;
-            if (_e298 > lohi0_.x) {
-                float _e301 = d_1;
-                local_5 = _e301 <= lohi0_.y;
-            } else {
-                local_5 = false;
-            }
-            bool _e307 = local_5;
-            if (_e307) {
-                float _e308 = d_1;
-                uint _e312 = bounds_index(naga_f2u32(b1_2) - 1u, _e78, frame);
-                metal::float2 _e315 = bounds[metal::min(unsigned(_e312), (_buffer_sizes.size6 - 0 - 8) / 8)];
-                float _e316 = moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(_e308, _e315);
-                metal::float4 _e318 = filtered_load(x00_, _e78, 0u, frame, filtered, _buffer_sizes);
-                metal::float4 _e320 = filtered_load(x01_, _e78, 0u, frame, filtered, _buffer_sizes);
-                metal::float4 m0_ = metal::mix(_e318, _e320, fx0_);
-                metal::float4 _e323 = filtered_load(x00_, _e78, 1u, frame, filtered, _buffer_sizes);
-                metal::float4 _e325 = filtered_load(x01_, _e78, 1u, frame, filtered, _buffer_sizes);
-                metal::float4 m1_ = metal::mix(_e323, _e325, fx0_);
-                float _e328 = lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(m0_, m1_.xy, _e316);
-                vis0_ = _e328;
-            }
-            float _e329 = d_1;
-            if (_e329 > lohi1_.x) {
-                float _e332 = d_1;
-                local_6 = _e332 <= lohi1_.y;
-            } else {
-                local_6 = false;
-            }
-            bool _e338 = local_6;
-            if (_e338) {
-                float _e339 = d_1;
-                uint _e343 = bounds_index(naga_f2u32(b1_2) - 1u, row1_, frame);
-                metal::float2 _e346 = bounds[metal::min(unsigned(_e343), (_buffer_sizes.size6 - 0 - 8) / 8)];
-                float _e347 = moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(_e339, _e346);
-                metal::float4 _e349 = filtered_load(x10_, row1_, 0u, frame, filtered, _buffer_sizes);
-                metal::float4 _e351 = filtered_load(x11_, row1_, 0u, frame, filtered, _buffer_sizes);
-                metal::float4 m0_1 = metal::mix(_e349, _e351, fx1_);
-                metal::float4 _e354 = filtered_load(x10_, row1_, 1u, frame, filtered, _buffer_sizes);
-                metal::float4 _e356 = filtered_load(x11_, row1_, 1u, frame, filtered, _buffer_sizes);
-                metal::float4 m1_1 = metal::mix(_e354, _e356, fx1_);
-                float _e359 = lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(m0_1, m1_1.xy, _e347);
-                vis1_ = _e359;
-            }
-            float _e360 = vis0_;
-            float _e361 = d_1;
-            float _e366 = d_1;
-            vis0_ = (_e366 <= lohi0_.x) ? 1.0 : ((_e361 > lohi0_.y) ? 0.0 : _e360);
-            float _e371 = vis1_;
-            float _e372 = d_1;
-            float _e377 = d_1;
-            vis1_ = (_e377 <= lohi1_.x) ? 1.0 : ((_e372 > lohi1_.y) ? 0.0 : _e371);
-            bool _e383 = done0_;
-            if (!(_e383)) {
-                float _e386 = total0_;
-                float _e387 = weight0_;
-                float _e388 = vis0_;
-                total0_ = _e386 + (_e387 * metal::clamp(_e388, 0.0, 1.0));
-            }
-            bool _e395 = done1_;
-            if (!(_e395)) {
-                float _e398 = total1_;
-                float _e399 = weight1_;
-                float _e400 = vis1_;
-                total1_ = _e398 + (_e399 * metal::clamp(_e400, 0.0, 1.0));
-            }
-            bool _e406 = done0_;
-            if (!(_e406)) {
-                local_7 = is_last0_;
-            } else {
-                local_7 = true;
-            }
-            bool _e411 = local_7;
-            done0_ = _e411;
-            bool _e412 = done1_;
-            if (!(_e412)) {
-                local_8 = is_last1_;
-            } else {
-                local_8 = true;
-            }
-            bool _e417 = local_8;
-            done1_ = _e417;
-            bool _e418 = done0_;
-            if (_e418) {
-                bool _e419 = done1_;
-                local_9 = _e419;
+            float _e398 = d_1;
+            if (_e398 > lohi0_.x) {
+                float _e401 = d_1;
+                local_9 = _e401 <= lohi0_.y;
             } else {
                 local_9 = false;
             }
-            bool _e423 = local_9;
-            if (_e423) {
+            bool _e407 = local_9;
+            if (_e407) {
+                float _e408 = d_1;
+                uint _e412 = bounds_index(naga_f2u32(b1_2) - 1u, _e78, frame);
+                metal::float2 _e415 = bounds[metal::min(unsigned(_e412), (_buffer_sizes.size6 - 0 - 8) / 8)];
+                float _e416 = moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(_e408, _e415);
+                metal::float4 _e418 = filtered_load(x00_, _e78, 0u, frame, filtered, _buffer_sizes);
+                metal::float4 _e420 = filtered_load(x01_, _e78, 0u, frame, filtered, _buffer_sizes);
+                metal::float4 m0_ = metal::mix(_e418, _e420, fx0_);
+                metal::float4 _e423 = filtered_load(x00_, _e78, 1u, frame, filtered, _buffer_sizes);
+                metal::float4 _e425 = filtered_load(x01_, _e78, 1u, frame, filtered, _buffer_sizes);
+                metal::float4 m1_ = metal::mix(_e423, _e425, fx0_);
+                float _e428 = lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(m0_, m1_.xy, _e416);
+                vis0_ = _e428;
+            }
+            float _e429 = d_1;
+            if (_e429 > lohi1_.x) {
+                float _e432 = d_1;
+                local_10 = _e432 <= lohi1_.y;
+            } else {
+                local_10 = false;
+            }
+            bool _e438 = local_10;
+            if (_e438) {
+                float _e439 = d_1;
+                uint _e443 = bounds_index(naga_f2u32(b1_2) - 1u, row1_, frame);
+                metal::float2 _e446 = bounds[metal::min(unsigned(_e443), (_buffer_sizes.size6 - 0 - 8) / 8)];
+                float _e447 = moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(_e439, _e446);
+                metal::float4 _e449 = filtered_load(x10_, row1_, 0u, frame, filtered, _buffer_sizes);
+                metal::float4 _e451 = filtered_load(x11_, row1_, 0u, frame, filtered, _buffer_sizes);
+                metal::float4 m0_1 = metal::mix(_e449, _e451, fx1_);
+                metal::float4 _e454 = filtered_load(x10_, row1_, 1u, frame, filtered, _buffer_sizes);
+                metal::float4 _e456 = filtered_load(x11_, row1_, 1u, frame, filtered, _buffer_sizes);
+                metal::float4 m1_1 = metal::mix(_e454, _e456, fx1_);
+                float _e459 = lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(m0_1, m1_1.xy, _e447);
+                vis1_ = _e459;
+            }
+            float _e460 = vis0_;
+            float _e461 = d_1;
+            float _e466 = d_1;
+            vis0_ = (_e466 <= lohi0_.x) ? 1.0 : ((_e461 > lohi0_.y) ? 0.0 : _e460);
+            float _e471 = vis1_;
+            float _e472 = d_1;
+            float _e477 = d_1;
+            vis1_ = (_e477 <= lohi1_.x) ? 1.0 : ((_e472 > lohi1_.y) ? 0.0 : _e471);
+            float _e482 = vis0_;
+            float _e487 = prev0_;
+            vis0_ = before0_ ? _e487 : metal::clamp(_e482, 0.0, 1.0);
+            float _e489 = vis1_;
+            float _e494 = prev1_;
+            vis1_ = before1_ ? _e494 : metal::clamp(_e489, 0.0, 1.0);
+            float _e496 = vis0_;
+            prev0_ = _e496;
+            float _e497 = vis1_;
+            prev1_ = _e497;
+            bool _e499 = done0_;
+            if (!(_e499)) {
+                float _e502 = total0_;
+                float _e503 = weight0_;
+                float _e504 = vis0_;
+                total0_ = _e502 + (_e503 * _e504);
+            }
+            bool _e508 = done1_;
+            if (!(_e508)) {
+                float _e511 = total1_;
+                float _e512 = weight1_;
+                float _e513 = vis1_;
+                total1_ = _e511 + (_e512 * _e513);
+            }
+            bool _e516 = done0_;
+            if (!(_e516)) {
+                local_11 = is_last0_;
+            } else {
+                local_11 = true;
+            }
+            bool _e521 = local_11;
+            done0_ = _e521;
+            bool _e522 = done1_;
+            if (!(_e522)) {
+                local_12 = is_last1_;
+            } else {
+                local_12 = true;
+            }
+            bool _e527 = local_12;
+            done1_ = _e527;
+            bool _e528 = done0_;
+            if (_e528) {
+                bool _e529 = done1_;
+                local_13 = _e529;
+            } else {
+                local_13 = false;
+            }
+            bool _e533 = local_13;
+            if (_e533) {
                 break;
             }
         }
     }
-    float _e429 = total0_;
-    float _e431 = total1_;
-    float l_2 = ((1.0 - w1_) * _e429) + (w1_ * _e431);
+    float _e539 = total0_;
+    float _e541 = total1_;
+    float l_2 = ((1.0 - w1_) * _e539) + (w1_ * _e541);
     metal::float3 c_1 = color * l_2;
     return c_1;
 }

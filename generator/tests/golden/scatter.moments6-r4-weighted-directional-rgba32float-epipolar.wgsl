@@ -604,9 +604,15 @@ fn scatter_pixel(x_9: u32, y_1: u32) -> vec3<f32> {
     var total1_: f32 = 0f;
     var done0_: bool = false;
     var done1_: bool = false;
+    var prev0_: f32 = 0f;
+    var prev1_: f32 = 0f;
     var r_1: u32 = 0u;
     var local_3: bool;
     var local_4: bool;
+    var local_5: bool;
+    var local_6: bool;
+    var local_7: bool;
+    var local_8: bool;
     var a0_: f32;
     var e0_: f32;
     var a1_: f32;
@@ -615,11 +621,11 @@ fn scatter_pixel(x_9: u32, y_1: u32) -> vec3<f32> {
     var weight1_: f32;
     var vis0_: f32;
     var vis1_: f32;
-    var local_5: bool;
-    var local_6: bool;
-    var local_7: bool;
-    var local_8: bool;
     var local_9: bool;
+    var local_10: bool;
+    var local_11: bool;
+    var local_12: bool;
+    var local_13: bool;
 
     let f_13 = frame;
     let eye_8 = f_13.eye.xyz;
@@ -682,77 +688,111 @@ fn scatter_pixel(x_9: u32, y_1: u32) -> vec3<f32> {
     let last0_ = u32(min(max(_e132, 0f), (f32(width_1) - 1f)));
     let _e140 = xs1_;
     let last1_ = u32(min(max(_e140, 0f), (f32(width_1) - 1f)));
+    let _e148 = xs0_;
+    let cap0_ = floor(((floor((_e148 * 1f)) + 1f) / 1f));
+    let _e157 = xs1_;
+    let cap1_ = floor(((floor((_e157 * 1f)) + 1f) / 1f));
     loop {
-        let _e150 = r_1;
-        if (_e150 < REGIONS) {
+        let _e168 = r_1;
+        if (_e168 < REGIONS) {
         } else {
             break;
         }
         {
-            let _e152 = r_1;
-            let _e153 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e152, REGIONS, width_1, false);
-            let b0_ = f32(_e153);
-            let _e155 = r_1;
-            let _e158 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e155 + 1u), REGIONS, width_1, false);
-            let b1_2 = f32(_e158);
+            let _e170 = r_1;
+            let _e171 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e170, REGIONS, width_1, false);
+            let b0_ = f32(_e171);
+            let _e173 = r_1;
+            let _e176 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e173 + 1u), REGIONS, width_1, false);
+            let b1_2 = f32(_e176);
             if !((last0_ < u32(b1_2))) {
-                let _e163 = r_1;
-                local_3 = ((_e163 + 1u) == REGIONS);
+                let _e181 = r_1;
+                local_3 = ((_e181 + 1u) == REGIONS);
             } else {
                 local_3 = true;
             }
             let is_last0_ = local_3;
             if !((last1_ < u32(b1_2))) {
-                let _e174 = r_1;
-                local_4 = ((_e174 + 1u) == REGIONS);
+                let _e192 = r_1;
+                local_4 = ((_e192 + 1u) == REGIONS);
             } else {
                 local_4 = true;
             }
             let is_last1_ = local_4;
-            let _e184 = xs0_;
-            let pos0_ = select((b1_2 - 0.5f), clamp((_e184 - 0.5f), (b0_ + 0.5f), (b1_2 - 0.5f)), is_last0_);
-            let _e195 = xs1_;
-            let pos1_ = select((b1_2 - 0.5f), clamp((_e195 - 0.5f), (b0_ + 0.5f), (b1_2 - 0.5f)), is_last1_);
+            let _e202 = xs0_;
+            let pos0_ = select((b1_2 - 0.5f), clamp((_e202 - 0.5f), (b0_ + 0.5f), (b1_2 - 0.5f)), is_last0_);
+            let _e213 = xs1_;
+            let pos1_ = select((b1_2 - 0.5f), clamp((_e213 - 0.5f), (b0_ + 0.5f), (b1_2 - 0.5f)), is_last1_);
+            let _e224 = xs0_;
+            let bb0_ = (select((b1_2 - 0.5f), clamp((min(_e224, cap0_) - 0.5f), (b0_ + 0.5f), (b1_2 - 0.5f)), is_last0_) - 0.5f);
+            let _e238 = xs1_;
+            let bb1_ = (select((b1_2 - 0.5f), clamp((min(_e238, cap1_) - 0.5f), (b0_ + 0.5f), (b1_2 - 0.5f)), is_last1_) - 0.5f);
+            if is_last0_ {
+                local_5 = (cap0_ <= b0_);
+            } else {
+                local_5 = false;
+            }
+            let _e254 = local_5;
+            if _e254 {
+                let _e255 = r_1;
+                local_6 = (_e255 > 0u);
+            } else {
+                local_6 = false;
+            }
+            let before0_ = local_6;
+            if is_last1_ {
+                local_7 = (cap1_ <= b0_);
+            } else {
+                local_7 = false;
+            }
+            let _e266 = local_7;
+            if _e266 {
+                let _e267 = r_1;
+                local_8 = (_e267 > 0u);
+            } else {
+                local_8 = false;
+            }
+            let before1_ = local_8;
             a0_ = f32();
             e0_ = f32();
             a1_ = f32();
             e1_ = f32();
-            let _e212 = delta0_;
-            let _e213 = theta_3;
-            let _e214 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b0_, _e212, _e213, s_5, false);
-            a0_ = _e214;
-            let _e215 = delta0_;
-            let _e216 = theta_3;
-            let _e217 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b1_2, _e215, _e216, s_5, false);
-            e0_ = select(_e217, s_5, is_last0_);
-            let _e219 = delta1_;
-            let _e220 = theta_3;
-            let _e221 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b0_, _e219, _e220, s_5, false);
-            a1_ = _e221;
-            let _e222 = delta1_;
-            let _e223 = theta_3;
-            let _e224 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b1_2, _e222, _e223, s_5, false);
-            e1_ = select(_e224, s_5, is_last1_);
+            let _e282 = delta0_;
+            let _e283 = theta_3;
+            let _e284 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b0_, _e282, _e283, s_5, false);
+            a0_ = _e284;
+            let _e285 = delta0_;
+            let _e286 = theta_3;
+            let _e287 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b1_2, _e285, _e286, s_5, false);
+            e0_ = select(_e287, s_5, is_last0_);
+            let _e289 = delta1_;
+            let _e290 = theta_3;
+            let _e291 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b0_, _e289, _e290, s_5, false);
+            a1_ = _e291;
+            let _e292 = delta1_;
+            let _e293 = theta_3;
+            let _e294 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b1_2, _e292, _e293, s_5, false);
+            e1_ = select(_e294, s_5, is_last1_);
             weight0_ = f32();
             weight1_ = f32();
             if false {
-                let _e230 = a0_;
-                let _e231 = e0_;
-                let _e232 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, _e10, _e230, _e231, panels_2);
-                weight0_ = _e232;
-                let _e233 = a1_;
-                let _e234 = e1_;
-                let _e235 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, _e10, _e233, _e234, panels_2);
-                weight1_ = _e235;
+                let _e300 = a0_;
+                let _e301 = e0_;
+                let _e302 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, _e10, _e300, _e301, panels_2);
+                weight0_ = _e302;
+                let _e303 = a1_;
+                let _e304 = e1_;
+                let _e305 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, _e10, _e303, _e304, panels_2);
+                weight1_ = _e305;
             } else {
-                let _e238 = a0_;
-                let _e239 = e0_;
-                let _e240 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.x, _e238, _e239);
-                weight0_ = (sun_scatter * _e240);
-                let _e244 = a1_;
-                let _e245 = e1_;
-                let _e246 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.x, _e244, _e245);
-                weight1_ = (sun_scatter * _e246);
+                let _e308 = a0_;
+                let _e309 = e0_;
+                let _e310 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.x, _e308, _e309);
+                weight0_ = (sun_scatter * _e310);
+                let _e314 = a1_;
+                let _e315 = e1_;
+                let _e316 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.x, _e314, _e315);
+                weight1_ = (sun_scatter * _e316);
             }
             let xb0_ = (pos0_ - 0.5f);
             let fx0_ = (xb0_ - floor(xb0_));
@@ -762,114 +802,126 @@ fn scatter_pixel(x_9: u32, y_1: u32) -> vec3<f32> {
             let fx1_ = (xb1_ - floor(xb1_));
             let x10_ = u32(clamp(floor(xb1_), 0f, (f32(width_1) - 1f)));
             let x11_ = select(x10_, min((x10_ + 1u), (width_1 - 1u)), (xb1_ > floor(xb1_)));
-            let _e286 = bounds_index(x01_, _e78);
-            let lohi0_ = bounds[_e286];
-            let _e290 = bounds_index(x11_, row1_);
-            let lohi1_ = bounds[_e290];
+            let xb00_ = u32(clamp(floor(bb0_), 0f, (f32(width_1) - 1f)));
+            let xb10_ = u32(clamp(floor(bb1_), 0f, (f32(width_1) - 1f)));
+            let _e378 = bounds_index(select(xb00_, min((xb00_ + 1u), (width_1 - 1u)), (bb0_ > floor(bb0_))), _e78);
+            let lohi0_ = bounds[_e378];
+            let _e390 = bounds_index(select(xb10_, min((xb10_ + 1u), (width_1 - 1u)), (bb1_ > floor(bb1_))), row1_);
+            let lohi1_ = bounds[_e390];
             vis0_ = 0.5f;
             vis1_ = 0.5f;
-            let _e298 = d_1;
-            if (_e298 > lohi0_.x) {
-                let _e301 = d_1;
-                local_5 = (_e301 <= lohi0_.y);
-            } else {
-                local_5 = false;
-            }
-            let _e307 = local_5;
-            if _e307 {
-                let _e308 = d_1;
-                let _e312 = bounds_index((u32(b1_2) - 1u), _e78);
-                let _e315 = bounds[_e312];
-                let _e316 = moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(_e308, _e315);
-                let _e318 = filtered_load(x00_, _e78, 0u);
-                let _e320 = filtered_load(x01_, _e78, 0u);
-                let m0_ = mix(_e318, _e320, fx0_);
-                let _e323 = filtered_load(x00_, _e78, 1u);
-                let _e325 = filtered_load(x01_, _e78, 1u);
-                let m1_ = mix(_e323, _e325, fx0_);
-                let _e328 = lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(m0_, m1_.xy, _e316);
-                vis0_ = _e328;
-            }
-            let _e329 = d_1;
-            if (_e329 > lohi1_.x) {
-                let _e332 = d_1;
-                local_6 = (_e332 <= lohi1_.y);
-            } else {
-                local_6 = false;
-            }
-            let _e338 = local_6;
-            if _e338 {
-                let _e339 = d_1;
-                let _e343 = bounds_index((u32(b1_2) - 1u), row1_);
-                let _e346 = bounds[_e343];
-                let _e347 = moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(_e339, _e346);
-                let _e349 = filtered_load(x10_, row1_, 0u);
-                let _e351 = filtered_load(x11_, row1_, 0u);
-                let m0_1 = mix(_e349, _e351, fx1_);
-                let _e354 = filtered_load(x10_, row1_, 1u);
-                let _e356 = filtered_load(x11_, row1_, 1u);
-                let m1_1 = mix(_e354, _e356, fx1_);
-                let _e359 = lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(m0_1, m1_1.xy, _e347);
-                vis1_ = _e359;
-            }
-            let _e360 = vis0_;
-            let _e361 = d_1;
-            let _e366 = d_1;
-            vis0_ = select(select(_e360, 0f, (_e361 > lohi0_.y)), 1f, (_e366 <= lohi0_.x));
-            let _e371 = vis1_;
-            let _e372 = d_1;
-            let _e377 = d_1;
-            vis1_ = select(select(_e371, 0f, (_e372 > lohi1_.y)), 1f, (_e377 <= lohi1_.x));
-            let _e383 = done0_;
-            if !(_e383) {
-                let _e386 = total0_;
-                let _e387 = weight0_;
-                let _e388 = vis0_;
-                total0_ = (_e386 + (_e387 * clamp(_e388, 0f, 1f)));
-            }
-            let _e395 = done1_;
-            if !(_e395) {
-                let _e398 = total1_;
-                let _e399 = weight1_;
-                let _e400 = vis1_;
-                total1_ = (_e398 + (_e399 * clamp(_e400, 0f, 1f)));
-            }
-            let _e406 = done0_;
-            if !(_e406) {
-                local_7 = is_last0_;
-            } else {
-                local_7 = true;
-            }
-            let _e411 = local_7;
-            done0_ = _e411;
-            let _e412 = done1_;
-            if !(_e412) {
-                local_8 = is_last1_;
-            } else {
-                local_8 = true;
-            }
-            let _e417 = local_8;
-            done1_ = _e417;
-            let _e418 = done0_;
-            if _e418 {
-                let _e419 = done1_;
-                local_9 = _e419;
+            let _e398 = d_1;
+            if (_e398 > lohi0_.x) {
+                let _e401 = d_1;
+                local_9 = (_e401 <= lohi0_.y);
             } else {
                 local_9 = false;
             }
-            let _e423 = local_9;
-            if _e423 {
+            let _e407 = local_9;
+            if _e407 {
+                let _e408 = d_1;
+                let _e412 = bounds_index((u32(b1_2) - 1u), _e78);
+                let _e415 = bounds[_e412];
+                let _e416 = moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(_e408, _e415);
+                let _e418 = filtered_load(x00_, _e78, 0u);
+                let _e420 = filtered_load(x01_, _e78, 0u);
+                let m0_ = mix(_e418, _e420, fx0_);
+                let _e423 = filtered_load(x00_, _e78, 1u);
+                let _e425 = filtered_load(x01_, _e78, 1u);
+                let m1_ = mix(_e423, _e425, fx0_);
+                let _e428 = lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(m0_, m1_.xy, _e416);
+                vis0_ = _e428;
+            }
+            let _e429 = d_1;
+            if (_e429 > lohi1_.x) {
+                let _e432 = d_1;
+                local_10 = (_e432 <= lohi1_.y);
+            } else {
+                local_10 = false;
+            }
+            let _e438 = local_10;
+            if _e438 {
+                let _e439 = d_1;
+                let _e443 = bounds_index((u32(b1_2) - 1u), row1_);
+                let _e446 = bounds[_e443];
+                let _e447 = moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(_e439, _e446);
+                let _e449 = filtered_load(x10_, row1_, 0u);
+                let _e451 = filtered_load(x11_, row1_, 0u);
+                let m0_1 = mix(_e449, _e451, fx1_);
+                let _e454 = filtered_load(x10_, row1_, 1u);
+                let _e456 = filtered_load(x11_, row1_, 1u);
+                let m1_1 = mix(_e454, _e456, fx1_);
+                let _e459 = lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(m0_1, m1_1.xy, _e447);
+                vis1_ = _e459;
+            }
+            let _e460 = vis0_;
+            let _e461 = d_1;
+            let _e466 = d_1;
+            vis0_ = select(select(_e460, 0f, (_e461 > lohi0_.y)), 1f, (_e466 <= lohi0_.x));
+            let _e471 = vis1_;
+            let _e472 = d_1;
+            let _e477 = d_1;
+            vis1_ = select(select(_e471, 0f, (_e472 > lohi1_.y)), 1f, (_e477 <= lohi1_.x));
+            let _e482 = vis0_;
+            let _e487 = prev0_;
+            vis0_ = select(clamp(_e482, 0f, 1f), _e487, before0_);
+            let _e489 = vis1_;
+            let _e494 = prev1_;
+            vis1_ = select(clamp(_e489, 0f, 1f), _e494, before1_);
+            let _e496 = vis0_;
+            prev0_ = _e496;
+            let _e497 = vis1_;
+            prev1_ = _e497;
+            let _e499 = done0_;
+            if !(_e499) {
+                let _e502 = total0_;
+                let _e503 = weight0_;
+                let _e504 = vis0_;
+                total0_ = (_e502 + (_e503 * _e504));
+            }
+            let _e508 = done1_;
+            if !(_e508) {
+                let _e511 = total1_;
+                let _e512 = weight1_;
+                let _e513 = vis1_;
+                total1_ = (_e511 + (_e512 * _e513));
+            }
+            let _e516 = done0_;
+            if !(_e516) {
+                local_11 = is_last0_;
+            } else {
+                local_11 = true;
+            }
+            let _e521 = local_11;
+            done0_ = _e521;
+            let _e522 = done1_;
+            if !(_e522) {
+                local_12 = is_last1_;
+            } else {
+                local_12 = true;
+            }
+            let _e527 = local_12;
+            done1_ = _e527;
+            let _e528 = done0_;
+            if _e528 {
+                let _e529 = done1_;
+                local_13 = _e529;
+            } else {
+                local_13 = false;
+            }
+            let _e533 = local_13;
+            if _e533 {
                 break;
             }
         }
         continuing {
-            let _e425 = r_1;
-            r_1 = (_e425 + 1u);
+            let _e535 = r_1;
+            r_1 = (_e535 + 1u);
         }
     }
-    let _e429 = total0_;
-    let _e431 = total1_;
-    let l_2 = (((1f - w1_) * _e429) + (w1_ * _e431));
+    let _e539 = total0_;
+    let _e541 = total1_;
+    let l_2 = (((1f - w1_) * _e539) + (w1_ * _e541));
     let c_1 = (color * l_2);
     return c_1;
 }

@@ -185,6 +185,14 @@ pub fn scatter_main(
     let last1 = min(max(xs1, 0.0), width as f32 - 1.0) as u32;
     let (mut total0, mut total1) = (Vec3::ZERO, Vec3::ZERO);
     let (mut done0, mut done1) = (false, false);
+    // The furthest stored edge a row's bounds lookup may read in the ray's last region: the
+    // last one at most one rectified column past the ray's end (see the WGSL).
+    let kf = stride as f32;
+    let cap0 = (((xs0 * kf).floor() + 1.0) / kf).floor();
+    let cap1 = (((xs1 * kf).floor() + 1.0) / kf).floor();
+    // The previous region's lit fraction per row, for a last region whose first stored edge
+    // lies past `cap`.
+    let (mut prev0, mut prev1) = (Vec3::ZERO, Vec3::ZERO);
     for r in 0..regions {
         let b0 = region_start(r, regions, width, spot) as f32;
         let b1 = region_start(r + 1, regions, width, spot) as f32;
@@ -198,6 +206,13 @@ pub fn scatter_main(
             }
         };
         let (pos0, pos1) = (pos_of(xs0, is_last0), pos_of(xs1, is_last1));
+        // The bounds' lookup stops at `cap` (see the WGSL).
+        let (bpos0, bpos1) = (
+            pos_of(xs0.min(cap0), is_last0),
+            pos_of(xs1.min(cap1), is_last1),
+        );
+        let before0 = is_last0 && cap0 <= b0 && r > 0;
+        let before1 = is_last1 && cap1 <= b0 && r > 0;
         let ((a0, e0), (a1, e1)) = if proj {
             let mut a = 0.0;
             if r > 0 {
@@ -263,9 +278,9 @@ pub fn scatter_main(
         let (x00, x01, fx0) = texels(pos0);
         let (x10, x11, fx1) = texels(pos1);
         // Their depth bounds: a region's prefix bounds only widen along the row, so column
-        // x1's cover column x0's.
-        let lohi0 = inp.bounds.load(x01, row0, 0);
-        let lohi1 = inp.bounds.load(x11, row1, 0);
+        // x1's cover column x0's; x1 of the lookup stopped at `cap`.
+        let lohi0 = inp.bounds.load(texels(bpos0).1, row0, 0);
+        let lohi1 = inp.bounds.load(texels(bpos1).1, row1, 0);
         let ambiguous = |lohi: [f32; 4]| d > lohi[0] && d <= lohi[1];
         // The ray's depth in a row's moment coordinate: the region's whole depth range is its
         // bounds at its last stored column (`moment_z`).
@@ -340,6 +355,12 @@ pub fn scatter_main(
                 Vec3::splat(clamp(vis1, 0.0, 1.0)),
             )
         };
+        // A last region the ray ends under the first coarse column of: the previous region's
+        // fraction.
+        let add0 = if before0 { prev0 } else { add0 };
+        let add1 = if before1 { prev1 } else { add1 };
+        prev0 = add0;
+        prev1 = add1;
         if !done0 {
             total0 += weight0 * add0;
         }
