@@ -1287,8 +1287,8 @@ mod tests {
             ),
             (
                 "prefiltered",
-                "regions=9",
-                "--variant: regions must be in 1..=8, got 9",
+                "regions=17",
+                "--variant: regions must be in 1..=16, got 17",
             ),
             (
                 "prefiltered",
