@@ -2140,9 +2140,11 @@ pub fn write_area_chart(
     Ok(vec![svg_path, png_path])
 }
 
-/// The `tune` first-stage grid: prefiltered (M, R) over {16, 32, 64} x {1, 4, 8} (the
-/// paper's 8 bases per thread, rgba8unorm) and the moment basis with 4 or 6 moments and 4 or
-/// 8 regions, each with a 512x512 and a 256x256 rectified map,
+/// The `tune` first-stage grid: prefiltered (M, R) over {16, 32, 64} x {1, 4, 8, 16} (the
+/// default bases per thread, rgba8unorm) and the moment basis with 4 or 6 moments and 4, 8
+/// or 16 regions (16: the moment basis's most accurate configuration since stop 56), each
+/// with a 512x512 and a 256x256 rectified map (16 regions need 256 columns on a directional
+/// row),
 /// raymarch N over {16, 32, 64, 128, 256, 512} plus interleaved (64, 4x4) and (256, 4x4),
 /// minmax with both maps; for an area light (a case runs only the methods of its light),
 /// `area_ivsv` with 16, 64 and 256 VPLs, two grid sizes, the interleaved gather, and 64
@@ -2179,7 +2181,7 @@ pub fn tune_candidates() -> Vec<Method> {
     }
     for rectified in [None, Some([256, 256])] {
         for bases in [16, 32, 64] {
-            for regions in [1, 4, 8] {
+            for regions in [1, 4, 8, 16] {
                 out.push(Method::new(
                     PrefilteredVariant {
                         bases,
@@ -2191,7 +2193,7 @@ pub fn tune_candidates() -> Vec<Method> {
             }
         }
         for moments in PrefilteredVariant::MOMENTS {
-            for regions in [4, 8] {
+            for regions in [4, 8, 16] {
                 out.push(Method::new(
                     PrefilteredVariant {
                         regions,

@@ -171,6 +171,13 @@ fn variants(light: LightKind) -> Vec<FamilyVariant> {
         ..HybridVolumeVariant::default()
     }));
     if full() {
+        // Issue 13: the moment basis's most accurate configuration (16 regions of 16
+        // columns on this map; reported, NaN checked).
+        v.push(FamilyVariant::Prefiltered(PrefilteredVariant {
+            light,
+            regions: 16,
+            ..PrefilteredVariant::with_moments(6)
+        }));
         let prefiltered = FamilyVariant::Prefiltered(PrefilteredVariant {
             light,
             ..PrefilteredVariant::default()
@@ -209,6 +216,7 @@ fn labels() -> Vec<String> {
     l.push("partial_sum_tree r4-ep64x64".into());
     l.push("hybrid_volume n32".into());
     if full() {
+        l.push("prefiltered moments6-r16".into());
         for base in ["prefiltered m32-r4", "minmax"] {
             l.push(format!("{base}-lr{SAMPLED_SCALE}"));
             l.push(format!("{base}-ep64x64"));
