@@ -2357,10 +2357,18 @@ pub fn tune_refinements(table: &[TuneEntry], run: [u32; 2]) -> Vec<Method> {
                 }
             }
         }
-        // Every family with a rectified map: the next sizes.
+        // Every family with a rectified map: the next sizes, those wide enough for the
+        // variant (a prefiltered variant needs `filtered_stride x regions^2` columns: 16
+        // regions have no 128-column neighbour, which the frame set-up would refuse).
         if let Some(rect) = m.rectified(run) {
             for step in rect_steps(rect) {
-                push(Method::new(m.variant, rect_knob(step)));
+                let fits = match m.variant {
+                    FamilyVariant::Prefiltered(v) => v.min_rectified_width() <= step[0],
+                    _ => true,
+                };
+                if fits {
+                    push(Method::new(m.variant, rect_knob(step)));
+                }
             }
         }
     }
@@ -2604,5 +2612,24 @@ mod tests {
                 .collect::<Vec<_>>(),
             ["m16-r4-256x256", "n128-i1"]
         );
+    }
+
+    #[test]
+    fn refinements_skip_maps_too_narrow_for_the_regions() {
+        // The moment basis with 16 regions at 256^2 on the front: its smaller neighbour
+        // (128 columns, fewer than 16^2) is not a candidate; the larger one is.
+        let m16 = Method::new(
+            PrefilteredVariant {
+                regions: 16,
+                ..PrefilteredVariant::with_moments(6)
+            },
+            Some([256, 256]),
+        );
+        let table = vec![entry(m16, 0.01, 10.0)];
+        let knobs: Vec<String> = tune_refinements(&table, [512, 512])
+            .iter()
+            .map(Method::knobs)
+            .collect();
+        assert_eq!(knobs, ["moments6-r16"]); // 512x512 is the run's map
     }
 }
