@@ -2362,11 +2362,7 @@ pub fn tune_refinements(table: &[TuneEntry], run: [u32; 2]) -> Vec<Method> {
         // regions have no 128-column neighbour, which the frame set-up would refuse).
         if let Some(rect) = m.rectified(run) {
             for step in rect_steps(rect) {
-                let fits = match m.variant {
-                    FamilyVariant::Prefiltered(v) => v.min_rectified_width() <= step[0],
-                    _ => true,
-                };
-                if fits {
+                if m.variant.fits_rectified_width(step[0]) {
                     push(Method::new(m.variant, rect_knob(step)));
                 }
             }

@@ -315,6 +315,19 @@ impl fmt::Display for FamilyVariant {
     }
 }
 
+impl FamilyVariant {
+    /// Whether a rectified map `width` columns wide is wide enough for the variant: a
+    /// prefiltered variant needs [`PrefilteredVariant::min_rectified_width`] columns (the
+    /// frame set-up refuses fewer with `FrameError::RectifiedTooNarrow`); every other
+    /// family takes any width.
+    pub fn fits_rectified_width(&self, width: u32) -> bool {
+        match self {
+            Self::Prefiltered(v) => v.min_rectified_width() <= width,
+            _ => true,
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -370,5 +383,16 @@ mod tests {
             "raymarch-n64-i1"
         );
         assert_eq!(Family::Minmax.default_variant().label(), "minmax");
+    }
+
+    #[test]
+    fn sixteen_regions_need_256_columns() {
+        let r16 = FamilyVariant::from(PrefilteredVariant {
+            regions: 16,
+            ..PrefilteredVariant::default()
+        });
+        assert!(r16.fits_rectified_width(256));
+        assert!(!r16.fits_rectified_width(128));
+        assert!(Family::Minmax.default_variant().fits_rectified_width(1));
     }
 }

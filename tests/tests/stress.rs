@@ -284,12 +284,8 @@ impl Prepared {
     /// Whether the case's rectified map is wide enough for `method` (a prefiltered variant
     /// needs `filtered_stride x regions^2` columns: 16 regions do not fit `rectified_64`).
     fn fits(&self, method: &FamilyVariant) -> bool {
-        match self.variant(method) {
-            FamilyVariant::Prefiltered(v) => {
-                v.min_rectified_width() <= self.resolutions().rectified[0]
-            }
-            _ => true,
-        }
+        self.variant(method)
+            .fits_rectified_width(self.resolutions().rectified[0])
     }
 
     /// Runs `method` on the GPU (or its CPU mirrors without one): the output and, for the
