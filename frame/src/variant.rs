@@ -239,6 +239,18 @@ pub struct PrefilteredVariant {
     /// columns") for what it costs and saves.
     #[serde(skip_serializing_if = "is_one")]
     pub filtered_stride: u32,
+    /// With coarse filtered columns (`filtered_stride` above 1): `scatter` resumes each row's
+    /// running mean from the last stored column before the ray's end over the rectified
+    /// texels up to it (their depths, weights and the ray's truncated step series, Klehm's
+    /// sum `a(d) . B(d_i)` = `sum_k 2 / c_k sin(c_k (d_i - d))`), instead of reading a map
+    /// `filtered_stride` times coarser: the answer of `filtered_stride = 1` (up to rounding:
+    /// the resumed texels are not quantised to `storage`) from a quarter (k = 4) of its
+    /// stores, for at most k texels more per lookup. `prefilter` stores each stored column's
+    /// weight sum beside its bounds. Meant for sampled frames (`sampling = epipolar |
+    /// lowres`), which look up far fewer points than `prefilter` stores; see
+    /// `docs/roofline.md` ("Stop 58").
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub resume: bool,
 }
 
 fn is_one(v: &u32) -> bool {
@@ -266,6 +278,7 @@ impl Default for PrefilteredVariant {
             step: SamplingKnobs::DEFAULT_STEP,
             cookie: false,
             filtered_stride: 1,
+            resume: false,
         }
     }
 }
@@ -411,6 +424,24 @@ impl PrefilteredVariant {
                 allowed: "1, 2, 4 or 8".into(),
             });
         }
+        if self.resume && self.filtered_stride == 1 {
+            return Err(VariantError {
+                knob: "resume",
+                value: "true".into(),
+                allowed: "true only with filtered_stride = 2, 4 or 8 (with 1 every column is \
+                          stored and there is nothing to resume)"
+                    .into(),
+            });
+        }
+        if self.resume && self.cookie {
+            return Err(VariantError {
+                knob: "resume",
+                value: "true".into(),
+                allowed: "false with cookie = true (scatter does not resume a cookie's \
+                          per-channel means; use filtered_stride = 1 or a coarse map)"
+                    .into(),
+            });
+        }
         self.sampling_knobs().validate()?;
         crate::cookie::validate_cookie(self.cookie, self.light)
     }
@@ -434,7 +465,8 @@ impl PrefilteredVariant {
     /// lights, every storage format and both rectifications; sorted by those knobs; then the
     /// moment basis; then the spot with a cookie (each basis, both visibilities and
     /// rectifications, 3 regions where `regions` holds 3), all with `filtered_stride = 1`;
-    /// then the coarse-column variants ([`Self::stride_grid`]).
+    /// then the coarse-column variants ([`Self::stride_grid`]) and the `resume` ones
+    /// ([`Self::resume_grid`]).
     pub fn grid(regions: std::ops::RangeInclusive<u32>) -> Vec<PrefilteredVariant> {
         let mut out = Vec::new();
         for bases in [4, 8, 16, 32, 64, 128] {
@@ -508,7 +540,60 @@ impl PrefilteredVariant {
                 }
             }
         }
-        out.extend(Self::stride_grid(regions));
+        out.extend(Self::stride_grid(regions.clone()));
+        out.extend(Self::resume_grid(regions));
+        out
+    }
+
+    /// The `resume` variants of [`Self::grid`]: every `filtered_stride` above 1 with every
+    /// light, rectification and visibility, the five bases of [`Self::stride_grid`] and the
+    /// regions that fit [`Self::STRIDE_GRID_WIDTH`] cycling (24 variants: every knob value
+    /// meets every stride; no cookie, which `resume` does not take).
+    fn resume_grid(regions: std::ops::RangeInclusive<u32>) -> Vec<PrefilteredVariant> {
+        let bases = [
+            Self::default(),
+            Self {
+                bases: 16,
+                bases_per_thread: 8,
+                storage: Storage::Rgba16float,
+                ..Self::default()
+            },
+            Self {
+                bases: 8,
+                bases_per_thread: 4,
+                storage: Storage::Rgba32float,
+                ..Self::default()
+            },
+            Self::with_moments(4),
+            Self::with_moments(6),
+        ];
+        let mut out = Vec::new();
+        let mut n = 0;
+        for k in Self::FILTERED_STRIDES.into_iter().filter(|&k| k > 1) {
+            let fits: Vec<u32> = regions
+                .clone()
+                .filter(|r| k * r * r <= Self::STRIDE_GRID_WIDTH)
+                .collect();
+            if fits.is_empty() {
+                continue;
+            }
+            for &light in LightKind::SINGLE {
+                for &rectification in Rectification::ALL {
+                    for &visibility in VisibilityMode::ALL {
+                        out.push(PrefilteredVariant {
+                            regions: fits[n % fits.len()],
+                            visibility,
+                            light,
+                            rectification,
+                            filtered_stride: k,
+                            resume: true,
+                            ..bases[n % bases.len()]
+                        });
+                        n += 1;
+                    }
+                }
+            }
+        }
         out
     }
 
@@ -647,10 +732,13 @@ impl PrefilteredVariant {
         rectified_width / self.filtered_stride.max(1)
     }
 
-    /// `-stride{k}` for a `filtered_stride` other than 1, else empty.
+    /// `-stride{k}` for a `filtered_stride` other than 1 (`-stride{k}-resume` with `resume`),
+    /// else empty.
     fn stride_suffix(&self) -> String {
         if self.filtered_stride == 1 {
             String::new()
+        } else if self.resume {
+            format!("-stride{}-resume", self.filtered_stride)
         } else {
             format!("-stride{}", self.filtered_stride)
         }

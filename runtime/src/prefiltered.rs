@@ -225,8 +225,8 @@ impl Prefiltered {
             )?;
             check_limit(
                 PREFILTER,
-                "depth-bounds bytes (8 per stored column and rectified row)",
-                u64::from(wc) * u64::from(hr) * 8,
+                "depth-bounds bytes (8 per stored column and rectified row, 16 with resume)",
+                u64::from(wc) * u64::from(hr) * if variant.resume { 16 } else { 8 },
                 name,
                 limit,
             )?;
@@ -631,7 +631,8 @@ pub struct PrefilteredReadback {
     /// (`Wc = Wr / filtered_stride`, the stored columns),
     /// converted from the storage format to f32 (values in [0, 1]).
     pub filtered: Vec<[f32; 4]>,
-    /// Region-prefix depth bounds (min, max) per stored texel (`Wc x Hr`), row-major.
+    /// Region-prefix depth bounds (min, max) per stored texel (`Wc x Hr`), row-major; with
+    /// `resume` a second plane of `(W, 0)` follows (the region's weight sum up to the texel).
     pub bounds: Vec<[f32; 2]>,
     /// GPU time per pass, when the device has timestamps.
     pub gpu_times: Option<PrefilteredTimes>,
@@ -717,7 +718,11 @@ pub fn run_prefiltered_once(
     // The stored columns: rectified.width / filtered_stride.
     let stored = [variant.filtered_width(res.rectified[0]), res.rectified[1]];
     let filtered = filtered_layer_major(&read_buffer(ctx, PREFILTER, &filtered)?, variant, stored);
-    let bounds = bounds_row_major(&read_buffer(ctx, PREFILTER, &bounds)?, stored);
+    let bounds = bounds_row_major(
+        &read_buffer(ctx, PREFILTER, &bounds)?,
+        stored,
+        if variant.resume { 2 } else { 1 },
+    );
     let output = output
         .read(ctx, SCATTER)?
         .chunks_exact(8)
@@ -786,12 +791,13 @@ fn filtered_layer_major(
 
 /// The `bounds` buffer's bytes (element `x * Hr + y`, column-major) as `(min, max)` pairs
 /// row-major, `y * Wr + x`, as [`PrefilteredReadback::bounds`] documents.
-fn bounds_row_major(bytes: &[u8], [wr, hr]: [u32; 2]) -> Vec<[f32; 2]> {
+fn bounds_row_major(bytes: &[u8], [wr, hr]: [u32; 2], planes: usize) -> Vec<[f32; 2]> {
     let (wr, hr) = (wr as usize, hr as usize);
-    let mut out = vec![[0.0; 2]; wr * hr];
+    let mut out = vec![[0.0; 2]; planes * wr * hr];
     for (i, t) in bytes.chunks_exact(8).take(out.len()).enumerate() {
-        let (x, y) = (i / hr, i % hr);
-        out[y * wr + x] = [
+        let (plane, j) = (i / (wr * hr), i % (wr * hr));
+        let (x, y) = (j / hr, j % hr);
+        out[(plane * hr + y) * wr + x] = [
             f32::from_le_bytes([t[0], t[1], t[2], t[3]]),
             f32::from_le_bytes([t[4], t[5], t[6], t[7]]),
         ];

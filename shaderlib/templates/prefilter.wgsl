@@ -204,6 +204,10 @@ fn prefilter(@builtin(global_invocation_id) id: vec3<u32>) {
             hi = max(hi, d);
             if store {
                 bounds[bounds_index(x, row)] = vec2<f32>(lo, hi);
+{%- if resume %}
+                // The region's weight sum up to the texel, from which scatter resumes.
+                bounds[weight_index(x, row)] = vec2<f32>(wsum, 0.0);
+{%- endif %}
             }
         }
         let blend = select(0.0, w / wsum, wsum > 0.0);

@@ -86,10 +86,17 @@
 #import scatter::model::{ {%- if !moments %}PI, {% endif %}phase_hg, transmittance_between, transmittance_integral}
 #import scatter::epipolar::{Frame, in_epipole_disc, epipole_march, normalised_depth, pixel_dir, ray_column, ray_row_coord, ray_t, row_index, slice_params, spot_segment}
 {%- if moments %}
-#import scatter::prefiltered::region_start
-#import scatter::moments::{lit_moments{{ moment_count }}, moment_z}
+#import scatter::prefiltered::{region_start{% if resume %}, texel_weight{% endif %}}
+#import scatter::moments::{lit_moments{{ moment_count }}, moment_z{% if resume %}, moment_layer{% endif %}}
 {%- else %}
-#import scatter::prefiltered::{coeff4, fourier_step, region_start, turn}
+#import scatter::prefiltered::{coeff4, fourier_step, region_start, turn{% if resume %}, freq, texel_weight{% endif %}}
+{%- endif %}
+{%- if resume %}
+#import scatter::epipolar::{SliceParams, row_phi, slice_e}
+{%- if projective %}
+#import scatter::projective::proj_stored_depth
+#import scatter::prefiltered_projective::proj_texel_weight
+{%- endif %}
 {%- endif %}
 {%- if projective %}
 #import scatter::projective::{proj_boundary, proj_ray_depth, proj_reach}
@@ -118,6 +125,12 @@
 
 // Independent prefix regions per rectified row.
 const REGIONS: u32 = {{ regions }}u;
+// Rectified columns per column of the lookups below: STRIDE when they read the coarse map as
+// it is, 1 when they resume the running means between its stored columns (`resume`).
+const LOOKUP: u32 = {% if resume %}1u{% else %}STRIDE{% endif %};
+{%- if resume %}
+{% include "include/scatter_resume.wgsl" %}
+{%- endif %}
 {%- if !moments %}
 // rgba layers of `filtered` (bases / 4){% if cookie %} per colour channel{% endif %}.
 const LAYERS: u32 = {{ layers }}u;
@@ -154,8 +167,9 @@ fn scatter_pixel(x: u32, y: u32) -> vec3<f32> {
     // Rectified coordinates of the surface point.
     let axis = f.axis.xyz;
     let rows = f.sizes[3];
-    // The stored columns (Wr / STRIDE), which the lookups below count in.
-    let width = f.sizes[2] / STRIDE;
+    // The lookups' columns (Wr / LOOKUP: the stored ones, or with `resume` the rectified
+    // ones), which the lookups below count in.
+    let width = f.sizes[2] / LOOKUP;
     let regions = REGIONS;
     let wrap = f.anti_epipole[3] > 0.5;
     var yc: f32;
@@ -183,7 +197,8 @@ fn scatter_pixel(x: u32, y: u32) -> vec3<f32> {
         if spot {
             g = (f.axis[3] - s * q.z) / qs;
         }
-        xs = proj_column(f, g, regions, width, spot);
+        // (The coarse map's column times the stored columns' width in lookup columns.)
+        xs = f32(STRIDE / LOOKUP) * proj_column(f, g, regions, f.sizes[2] / STRIDE, spot);
     } else {
 {%- else %}
     {
@@ -246,9 +261,9 @@ fn scatter_pixel(x: u32, y: u32) -> vec3<f32> {
 {%- else %}
     {
 {%- endif %}
-        // A stored column spans STRIDE rectified columns.
-        delta0 = f32(STRIDE) * slice_params(slices[row0]).delta;
-        delta1 = f32(STRIDE) * slice_params(slices[row1]).delta;
+        // A lookup column spans LOOKUP rectified columns.
+        delta0 = f32(LOOKUP) * slice_params(slices[row0]).delta;
+        delta1 = f32(LOOKUP) * slice_params(slices[row1]).delta;
         xs0 = reach / delta0;
         xs1 = reach / delta1;
     }
@@ -265,16 +280,20 @@ fn scatter_pixel(x: u32, y: u32) -> vec3<f32> {
     // and lit closed rooms (window, 2.2e-2 of the lit maximum at filtered_stride 4, random
     // poses). The means still read the partial column (stopping them too cost 0.06 points
     // on the 24 poses' mean at stride 4).
-    let cap0 = floor((floor(xs0 * f32(STRIDE)) + 1.0) / f32(STRIDE));
-    let cap1 = floor((floor(xs1 * f32(STRIDE)) + 1.0) / f32(STRIDE));
+    let cap0 = floor((floor(xs0 * f32(LOOKUP)) + 1.0) / f32(LOOKUP));
+    let cap1 = floor((floor(xs1 * f32(LOOKUP)) + 1.0) / f32(LOOKUP));
     // The previous region's lit fraction per row: a last region whose first stored edge lies
     // past `cap` has no column the ray reaches through, and its part of the ray (under one
     // coarse column) takes the fraction of the region before it.
     var prev0 = {% if cookie %}vec3<f32>(0.0){% else %}0.0{% endif %};
     var prev1 = {% if cookie %}vec3<f32>(0.0){% else %}0.0{% endif %};
+{%- if resume %}
+    let proj_frame = {% if projective %}proj{% else %}false{% endif %};
+{%- endif %}
     for (var r = 0u; r < regions; r++) {
-        let b0 = f32(region_start(r, regions, width, spot));
-        let b1 = f32(region_start(r + 1u, regions, width, spot));
+        // The region's first and next region's first lookup column (on stored columns).
+        let b0 = f32(STRIDE / LOOKUP * region_start(r, regions, f.sizes[2] / STRIDE, spot));
+        let b1 = f32(STRIDE / LOOKUP * region_start(r + 1u, regions, f.sizes[2] / STRIDE, spot));
         let is_last0 = last0 < u32(b1) || r + 1u == regions;
         let is_last1 = last1 < u32(b1) || r + 1u == regions;
         let pos0 = select(b1 - 0.5, clamp(xs0 - 0.5, b0 + 0.5, b1 - 0.5), is_last0);
@@ -345,8 +364,17 @@ fn scatter_pixel(x: u32, y: u32) -> vec3<f32> {
         // x1's cover column x0's: one load per row, at x1 of the lookup stopped at `cap`.
         let xb00 = u32(clamp(floor(bb0), 0.0, f32(width) - 1.0));
         let xb10 = u32(clamp(floor(bb1), 0.0, f32(width) - 1.0));
+{%- if resume %}
+        // Resumed from each row's last stored column before x0 + 1 in the region (at a
+        // lookup of one rectified column the bounds' column is x1).
+        let from0 = resume_from(x00, u32(b0));
+        let from1 = resume_from(x10, u32(b0));
+        let lohi0 = resume_bounds(from0, u32(b0), x01, row0, proj_frame);
+        let lohi1 = resume_bounds(from1, u32(b0), x11, row1, proj_frame);
+{%- else %}
         let lohi0 = bounds[bounds_index(select(xb00, min(xb00 + 1u, width - 1u), bb0 > floor(bb0)), row0)];
         let lohi1 = bounds[bounds_index(select(xb10, min(xb10 + 1u, width - 1u), bb1 > floor(bb1)), row1)];
+{%- endif %}
 {%- if cookie %}
         // The region's mean cookie up to the ray's end, per row: the channel's lit share
         // lies in [0, Cbar].
@@ -357,8 +385,8 @@ fn scatter_pixel(x: u32, y: u32) -> vec3<f32> {
 {%- if moments %}
         // The ray's depth in each row's moment coordinate: the region's whole depth range is
         // its bounds at its last stored column (`moment_z`).
-        let zf0 = moment_z(d, bounds[bounds_index(u32(b1) - 1u, row0)]);
-        let zf1 = moment_z(d, bounds[bounds_index(u32(b1) - 1u, row1)]);
+        let zf0 = moment_z(d, bounds[bounds_index(u32(b1) * LOOKUP / STRIDE - 1u, row0)]);
+        let zf1 = moment_z(d, bounds[bounds_index(u32(b1) * LOOKUP / STRIDE - 1u, row1)]);
         // Per channel the moments of the cookie-weighted depths: the stored ones over Cbar.
         for (var c = 0u; c < 3u; c++) {
             if d > lohi0.x && d <= lohi0.y && cbar0[c] > 0.0 {
@@ -427,20 +455,38 @@ fn scatter_pixel(x: u32, y: u32) -> vec3<f32> {
         if d > lohi0.x && d <= lohi0.y {
             // The ray's depth in the row's moment coordinate: the region's whole depth range
             // is its bounds at its last stored column (`moment_z`).
-            let zf0 = moment_z(d, bounds[bounds_index(u32(b1) - 1u, row0)]);
+            let range0 = bounds[bounds_index(u32(b1) * LOOKUP / STRIDE - 1u, row0)];
+            let zf0 = moment_z(d, range0);
+{%- if resume %}
+            let mm0 = resume_moments(from0, u32(b0), x00, x01, fx0, range0, row0, r, proj_frame);
+            let m0 = mm0.a;
+            let m1 = mm0.b;
+{%- else %}
             let m0 = mix(filtered_load(x00, row0, 0), filtered_load(x01, row0, 0), fx0);
 {%- if moment_count == 6 %}
             let m1 = mix(filtered_load(x00, row0, 1), filtered_load(x01, row0, 1), fx0);
+{%- endif %}
+{%- endif %}
+{%- if moment_count == 6 %}
             vis0 = lit_moments6(m0, m1.xy, zf0);
 {%- else %}
             vis0 = lit_moments4(m0, zf0);
 {%- endif %}
         }
         if d > lohi1.x && d <= lohi1.y {
-            let zf1 = moment_z(d, bounds[bounds_index(u32(b1) - 1u, row1)]);
+            let range1 = bounds[bounds_index(u32(b1) * LOOKUP / STRIDE - 1u, row1)];
+            let zf1 = moment_z(d, range1);
+{%- if resume %}
+            let mm1 = resume_moments(from1, u32(b0), x10, x11, fx1, range1, row1, r, proj_frame);
+            let m0 = mm1.a;
+            let m1 = mm1.b;
+{%- else %}
             let m0 = mix(filtered_load(x10, row1, 0), filtered_load(x11, row1, 0), fx1);
 {%- if moment_count == 6 %}
             let m1 = mix(filtered_load(x10, row1, 1), filtered_load(x11, row1, 1), fx1);
+{%- endif %}
+{%- endif %}
+{%- if moment_count == 6 %}
             vis1 = lit_moments6(m0, m1.xy, zf1);
 {%- else %}
             vis1 = lit_moments4(m0, zf1);
@@ -448,6 +494,22 @@ fn scatter_pixel(x: u32, y: u32) -> vec3<f32> {
         }
 {%- else %}
         if (d > lohi0.x && d <= lohi0.y) || (d > lohi1.x && d <= lohi1.y) {
+{%- if resume %}
+            // a(d) . F at each row's stored column, then resumed up to x0 and x1.
+            var dot0 = 0.0;
+            var dot1 = 0.0;
+            for (var layer = 0u; layer < LAYERS; layer++) {
+                let coeff = coeffs[layer];
+                let texel0 = filtered_load(from0.x, row0, layer);
+                let texel1 = filtered_load(from1.x, row1, layer);
+                for (var k = 0u; k < 4u; k++) {
+                    dot0 += coeff[k] * (texel0[k] * 2.0 - 1.0);
+                    dot1 += coeff[k] * (texel1[k] * 2.0 - 1.0);
+                }
+            }
+            vis0 += resume_fourier(from0, u32(b0), x00, x01, fx0, d, dot0, row0, r, proj_frame);
+            vis1 += resume_fourier(from1, u32(b0), x10, x11, fx1, d, dot1, row1, r, proj_frame);
+{%- else %}
             for (var layer = 0u; layer < LAYERS; layer++) {
                 let coeff = coeffs[layer];
                 let texel0 = mix(filtered_load(x00, row0, layer), filtered_load(x01, row0, layer), fx0);
@@ -457,6 +519,7 @@ fn scatter_pixel(x: u32, y: u32) -> vec3<f32> {
                     vis1 += coeff[k] * (texel1[k] * 2.0 - 1.0);
                 }
             }
+{%- endif %}
         }
 {%- endif %}
         // Outside the row's depth range the region is exactly lit or shadowed.

@@ -39,6 +39,7 @@ use std::sync::OnceLock;
 use std::time::Instant;
 
 use scatter_conformance::{Check, Fixture, compare_slices, gpu, run_trials};
+use scatter_reference::kernels::common_prefiltered::{region_column, region_start};
 use scatter_reference::kernels::{PrefilteredRun, run_prefiltered};
 use scatter_reference::suite::{Pose, SceneName};
 use scatter_runtime::wgpu::TextureView;
@@ -71,6 +72,9 @@ fn rectified_for(variant: &PrefilteredVariant) -> [u32; 2] {
 const SHADOW_MAP: u32 = 128;
 
 const RECTIFIED_TOL: f32 = 1e-4;
+/// `resume`'s weight sums (bounds' second plane), relative: f32 sums of the same weights in
+/// the same order on both sides, apart by the weights' transcendentals.
+const WEIGHT_SUM_REL_TOL: f32 = 1e-4;
 
 /// The scene and pose of a light and rectification (see [`Fixture::get`]).
 const fn case(light: LightKind, rectification: Rectification) -> (SceneName, Pose) {
@@ -296,10 +300,18 @@ fn run_trial(
         }
     }
     // The bounds are minima and maxima of rectified depths: as close as the rectified maps.
+    // With `resume` the second plane holds the weight sums (W, 0): sums of the same f32
+    // weights in the same order, as close as their transcendentals (relative).
     let mut bounds = Worst::default();
+    let plane = cpu.bounds.data.len() / cpu.bounds.layers.max(1) as usize;
     for (i, (g, c)) in gpu.bounds.iter().zip(&cpu.bounds.data).enumerate() {
         for k in 0..2 {
-            bounds.update(2 * i + k, g[k], c[k], RECTIFIED_TOL);
+            let tol = if i < plane {
+                RECTIFIED_TOL
+            } else {
+                WEIGHT_SUM_REL_TOL * c[k].abs() + 1e-6
+            };
+            bounds.update(2 * i + k, g[k], c[k], tol);
         }
     }
     let max_radiance = cpu
@@ -361,6 +373,88 @@ fn describe(what: &str, w: &Worst, layout: impl Fn(usize) -> String) -> String {
 
 /// One variant's trial: the GPU against the mirror on its fixture, every output within its
 /// tolerance.
+/// The most a `resume` variant's output may differ from the same variant's at a stride of
+/// 1, relative to the larger's maximum radiance: the stride of 1 rounds every column's means
+/// to the storage format and `resume` only the stored ones, so the two differ by that
+/// rounding, at most sum_k |a_k| q = 2.97 q for m32 (|a_k| <= 2 / c_k per sine and cosine, q the
+/// decoded mean's rounding: 2 / 255 for rgba8unorm, 2^-10 for rgba16float); rgba32float and
+/// the moments (rgba32float) by the order of f32 sums, which the moment reconstruction's
+/// conditioning amplifies.
+fn resume_tol(storage: Storage) -> f32 {
+    match storage {
+        Storage::Rgba8unorm => 3.0 * 2.0 / 255.0,
+        Storage::Rgba16float => 3.0 * 2f32.powi(-10),
+        Storage::Rgba32float => 1e-3,
+    }
+}
+
+/// Whether `variant`'s regions start on the columns a stride of 1 starts them on (on its
+/// trial map).
+fn same_regions_as_stride_one(variant: &PrefilteredVariant) -> bool {
+    let width = rectified_for(variant)[0];
+    let spot = variant.light == LightKind::Spot;
+    (0..=variant.regions).all(|r| {
+        region_column(r, variant.regions, width, variant.filtered_stride, spot)
+            == region_start(r, variant.regions, width, spot)
+    })
+}
+
+/// `resume` gives the answer of a stride of 1 (CPU mirror, the variant's fixture): the
+/// outputs within [`resume_tol`], and the stride of 1's bounds at every stored column.
+fn resume_matches_stride_one(variant: &PrefilteredVariant) -> Result<(), String> {
+    let fixture = variant_fixture(variant);
+    let resumed = cpu_run(variant, fixture)?;
+    let one = PrefilteredVariant {
+        filtered_stride: 1,
+        resume: false,
+        ..*variant
+    };
+    let full = cpu_run(&one, fixture)?;
+    let max = full
+        .output
+        .data
+        .iter()
+        .chain(&resumed.output.data)
+        .flatten()
+        .fold(0.0f32, |m, &v| m.max(v));
+    let mut worst = (0.0f32, 0usize);
+    for (i, (a, b)) in resumed
+        .output
+        .data
+        .iter()
+        .zip(&full.output.data)
+        .enumerate()
+    {
+        for k in 0..3 {
+            let d = (a[k] - b[k]).abs();
+            if d > worst.0 {
+                worst = (d, i);
+            }
+        }
+    }
+    let tol = resume_tol(variant.storage) * max;
+    eprintln!(
+        "     {}: max |resume - stride 1| {:.3e} ({:.2e} of max {:.3e}; bar {:.1e})",
+        trial_name(variant),
+        worst.0,
+        worst.0 / max.max(1e-30),
+        max,
+        resume_tol(variant.storage)
+    );
+    if !(worst.0 <= tol) {
+        return Err(format!(
+            "{}: output differs from filtered_stride = 1 by {:.3e} at pixel {} (> {:.3e} = {:.1e} of max {:.3e})",
+            trial_name(variant),
+            worst.0,
+            worst.1,
+            tol,
+            resume_tol(variant.storage),
+            max
+        ));
+    }
+    Ok(())
+}
+
 fn conformance(variant: &PrefilteredVariant) -> Result<(), String> {
     let Some(ctx) = gpu() else { return Ok(()) };
     compare(ctx, variant, variant_fixture(variant))
@@ -491,6 +585,23 @@ fn main() -> ExitCode {
             (trial_name(&variant), check)
         })
         .collect();
+    // `resume` against the same variant at a stride of 1, both on the mirror: the math, not
+    // the GPU's agreement with it (the trials above). Only where both put the regions on the
+    // same columns: a stride of k starts them on multiples of k, and where the stride of 1
+    // does not (3 regions on the 64-column map: columns 7 and 28) the two are different
+    // variants.
+    for variant in PrefilteredVariant::grid(1..=4)
+        .into_iter()
+        .filter(|v| v.resume && same_regions_as_stride_one(v))
+    {
+        trials.push((
+            format!(
+                "prefiltered::resume_matches_stride_one::{}",
+                trial_name(&variant)
+            ),
+            Box::new(move || resume_matches_stride_one(&variant)),
+        ));
+    }
     for light in LightKind::SINGLE.iter().copied() {
         trials.push((
             format!("prefiltered::slice_fit::{light}"),

@@ -101,9 +101,20 @@ fn f16_ulp(v: f32) -> f32 {
 /// samples only and is checked against its mirror in `tests/tests/partial_sum_tree_gpu.rs`;
 /// `area_ivsv` for `light = area` only, on `area_grate`).
 fn bases(light: LightKind) -> Vec<FamilyVariant> {
+    // Each family's default, and prefiltered with `resume` (filtered_stride 4, the most the
+    // trials' 64-column map takes with 4 regions; the bench's sampled frames use 8,
+    // docs/roofline.md "Stop 58").
+    let resume: FamilyVariant = scatter_shaderlib::prefiltered::PrefilteredVariant {
+        filtered_stride: 4,
+        resume: true,
+        ..Default::default()
+    }
+    .into();
     Family::ALL
         .iter()
-        .map(|f| f.default_variant().with_light(light))
+        .map(|f| f.default_variant())
+        .chain([resume])
+        .map(|v| v.with_light(light))
         .filter(|v| v.validate().is_ok() && v.sampling().sampling == Sampling::Pixels)
         .filter(|v| {
             knobs()

@@ -115,8 +115,21 @@ pub fn knobs() -> Vec<KnobInfo> {
             default: d.filtered_stride.to_string(),
             value_type: KnobType::Integer,
         },
+        KnobInfo {
+            name: "resume",
+            value_name: "BOOL",
+            help: "with filtered_stride > 1: scatter resumes each running mean from the last \
+                   stored column before the ray's end over the rectified texels up to it (the \
+                   answer of filtered_stride = 1 from 1/K of its stores; for sampled frames)",
+            allowed: RESUME_ALLOWED.into(),
+            default: d.resume.to_string(),
+            value_type: KnobType::Boolean,
+        },
     ]
 }
+
+/// Allowed values of `resume`.
+const RESUME_ALLOWED: &str = "true | false";
 
 fn number(knob: &'static str, allowed: &str, value: &str) -> Result<u32, VariantError> {
     value.trim().parse().map_err(|_| VariantError {
@@ -157,6 +170,20 @@ pub fn parse(knobs: &[(String, String)]) -> Result<PrefilteredVariant, GenError>
             "rectification" => v.rectification = value.parse()?,
             "filtered_stride" => {
                 v.filtered_stride = number("filtered_stride", FILTERED_STRIDE_ALLOWED, value)?;
+            }
+            "resume" => {
+                v.resume = match value.trim() {
+                    "true" | "on" | "1" => true,
+                    "false" | "off" | "0" => false,
+                    _ => {
+                        return Err(VariantError {
+                            knob: "resume",
+                            value: value.clone(),
+                            allowed: RESUME_ALLOWED.into(),
+                        }
+                        .into());
+                    }
+                };
             }
             other => {
                 return Err(GenError::Usage(format!(

@@ -60,6 +60,7 @@ static const float4 GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX = float4(0.347
 static const float DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX = 0.1;
 static const uint STRIDE = 1u;
 static const uint REGIONS = 4u;
+static const uint LOOKUP = 1u;
 static const uint LAYERS = 8u;
 
 cbuffer frame : register(b0) { FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX frame; }
@@ -620,7 +621,7 @@ float3 scatter_pixel(uint x_6, uint y_1)
     }
     float3 axis = f_12.axis.xyz;
     uint rows_2 = f_12.sizes.w;
-    uint width_1 = naga_div(f_12.sizes.z, STRIDE);
+    uint width_1 = naga_div(f_12.sizes.z, LOOKUP);
     bool wrap_1 = (f_12.anti_epipole.w > 0.5);
     {
         theta_3 = atan2(length(cross(_e10, axis)), dot(_e10, axis));
@@ -708,8 +709,8 @@ float3 scatter_pixel(uint x_6, uint y_1)
         if (all(loop_bound_4 == uint2(0u, 0u))) { break; }
         loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
         if (!loop_init_4) {
-            uint _e577 = r_1;
-            r_1 = (_e577 + 1u);
+            uint _e589 = r_1;
+            r_1 = (_e589 + 1u);
         }
         loop_init_4 = false;
         uint _e196 = r_1;
@@ -719,42 +720,42 @@ float3 scatter_pixel(uint x_6, uint y_1)
         }
         {
             uint _e198 = r_1;
-            const uint _e199 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e198, REGIONS, width_1, false);
-            float b0_ = float(_e199);
-            uint _e201 = r_1;
-            const uint _e204 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e201 + 1u), REGIONS, width_1, false);
-            float b1_ = float(_e204);
+            const uint _e203 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e198, REGIONS, naga_div(f_12.sizes.z, STRIDE), false);
+            float b0_ = float((1u * _e203));
+            uint _e207 = r_1;
+            const uint _e214 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e207 + 1u), REGIONS, naga_div(f_12.sizes.z, STRIDE), false);
+            float b1_ = float((1u * _e214));
             if (!((last0_ < naga_f2u32(b1_)))) {
-                uint _e209 = r_1;
-                local_2 = ((_e209 + 1u) == REGIONS);
+                uint _e221 = r_1;
+                local_2 = ((_e221 + 1u) == REGIONS);
             } else {
                 local_2 = true;
             }
             bool is_last0_ = local_2;
             if (!((last1_ < naga_f2u32(b1_)))) {
-                uint _e220 = r_1;
-                local_3 = ((_e220 + 1u) == REGIONS);
+                uint _e232 = r_1;
+                local_3 = ((_e232 + 1u) == REGIONS);
             } else {
                 local_3 = true;
             }
             bool is_last1_ = local_3;
-            float _e230 = xs0_;
-            float pos0_ = (is_last0_ ? clamp((_e230 - 0.5), (b0_ + 0.5), (b1_ - 0.5)) : (b1_ - 0.5));
-            float _e241 = xs1_;
-            float pos1_ = (is_last1_ ? clamp((_e241 - 0.5), (b0_ + 0.5), (b1_ - 0.5)) : (b1_ - 0.5));
-            float _e252 = xs0_;
-            float bb0_ = ((is_last0_ ? clamp((min(_e252, cap0_) - 0.5), (b0_ + 0.5), (b1_ - 0.5)) : (b1_ - 0.5)) - 0.5);
-            float _e266 = xs1_;
-            float bb1_ = ((is_last1_ ? clamp((min(_e266, cap1_) - 0.5), (b0_ + 0.5), (b1_ - 0.5)) : (b1_ - 0.5)) - 0.5);
+            float _e242 = xs0_;
+            float pos0_ = (is_last0_ ? clamp((_e242 - 0.5), (b0_ + 0.5), (b1_ - 0.5)) : (b1_ - 0.5));
+            float _e253 = xs1_;
+            float pos1_ = (is_last1_ ? clamp((_e253 - 0.5), (b0_ + 0.5), (b1_ - 0.5)) : (b1_ - 0.5));
+            float _e264 = xs0_;
+            float bb0_ = ((is_last0_ ? clamp((min(_e264, cap0_) - 0.5), (b0_ + 0.5), (b1_ - 0.5)) : (b1_ - 0.5)) - 0.5);
+            float _e278 = xs1_;
+            float bb1_ = ((is_last1_ ? clamp((min(_e278, cap1_) - 0.5), (b0_ + 0.5), (b1_ - 0.5)) : (b1_ - 0.5)) - 0.5);
             if (is_last0_) {
                 local_4 = (cap0_ <= b0_);
             } else {
                 local_4 = false;
             }
-            bool _e282 = local_4;
-            if (_e282) {
-                uint _e283 = r_1;
-                local_5 = (_e283 > 0u);
+            bool _e294 = local_4;
+            if (_e294) {
+                uint _e295 = r_1;
+                local_5 = (_e295 > 0u);
             } else {
                 local_5 = false;
             }
@@ -764,10 +765,10 @@ float3 scatter_pixel(uint x_6, uint y_1)
             } else {
                 local_6 = false;
             }
-            bool _e294 = local_6;
-            if (_e294) {
-                uint _e295 = r_1;
-                local_7 = (_e295 > 0u);
+            bool _e306 = local_6;
+            if (_e306) {
+                uint _e307 = r_1;
+                local_7 = (_e307 > 0u);
             } else {
                 local_7 = false;
             }
@@ -776,42 +777,42 @@ float3 scatter_pixel(uint x_6, uint y_1)
             e0_ = ZeroValuefloat();
             a1_ = ZeroValuefloat();
             e1_ = ZeroValuefloat();
-            float _e310 = delta0_;
-            float _e311 = theta_3;
-            const float _e312 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b0_, _e310, _e311, s_3, false);
-            a0_ = _e312;
-            float _e313 = delta0_;
-            float _e314 = theta_3;
-            const float _e315 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b1_, _e313, _e314, s_3, false);
-            e0_ = (is_last0_ ? s_3 : _e315);
-            float _e317 = delta1_;
-            float _e318 = theta_3;
-            const float _e319 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b0_, _e317, _e318, s_3, false);
-            a1_ = _e319;
-            float _e320 = delta1_;
-            float _e321 = theta_3;
-            const float _e322 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b1_, _e320, _e321, s_3, false);
-            e1_ = (is_last1_ ? s_3 : _e322);
+            float _e322 = delta0_;
+            float _e323 = theta_3;
+            const float _e324 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b0_, _e322, _e323, s_3, false);
+            a0_ = _e324;
+            float _e325 = delta0_;
+            float _e326 = theta_3;
+            const float _e327 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b1_, _e325, _e326, s_3, false);
+            e0_ = (is_last0_ ? s_3 : _e327);
+            float _e329 = delta1_;
+            float _e330 = theta_3;
+            const float _e331 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b0_, _e329, _e330, s_3, false);
+            a1_ = _e331;
+            float _e332 = delta1_;
+            float _e333 = theta_3;
+            const float _e334 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b1_, _e332, _e333, s_3, false);
+            e1_ = (is_last1_ ? s_3 : _e334);
             weight0_ = ZeroValuefloat();
             weight1_ = ZeroValuefloat();
             if (false) {
-                float _e328 = a0_;
-                float _e329 = e0_;
-                const float _e330 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, _e10, _e328, _e329, panels_2);
-                weight0_ = _e330;
-                float _e331 = a1_;
-                float _e332 = e1_;
-                const float _e333 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, _e10, _e331, _e332, panels_2);
-                weight1_ = _e333;
+                float _e340 = a0_;
+                float _e341 = e0_;
+                const float _e342 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, _e10, _e340, _e341, panels_2);
+                weight0_ = _e342;
+                float _e343 = a1_;
+                float _e344 = e1_;
+                const float _e345 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, _e10, _e343, _e344, panels_2);
+                weight1_ = _e345;
             } else {
-                float _e336 = a0_;
-                float _e337 = e0_;
-                const float _e338 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.x, _e336, _e337);
-                weight0_ = (sun_scatter * _e338);
-                float _e342 = a1_;
-                float _e343 = e1_;
-                const float _e344 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.x, _e342, _e343);
-                weight1_ = (sun_scatter * _e344);
+                float _e348 = a0_;
+                float _e349 = e0_;
+                const float _e350 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.x, _e348, _e349);
+                weight0_ = (sun_scatter * _e350);
+                float _e354 = a1_;
+                float _e355 = e1_;
+                const float _e356 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.x, _e354, _e355);
+                weight1_ = (sun_scatter * _e356);
             }
             float xb0_ = (pos0_ - 0.5);
             float fx0_ = (xb0_ - floor(xb0_));
@@ -823,35 +824,35 @@ float3 scatter_pixel(uint x_6, uint y_1)
             uint x11_ = ((xb1_ > floor(xb1_)) ? min((x10_ + 1u), (width_1 - 1u)) : x10_);
             uint xb00_ = naga_f2u32(clamp(floor(bb0_), 0.0, (float(width_1) - 1.0)));
             uint xb10_ = naga_f2u32(clamp(floor(bb1_), 0.0, (float(width_1) - 1.0)));
-            const uint _e406 = bounds_index(((bb0_ > floor(bb0_)) ? min((xb00_ + 1u), (width_1 - 1u)) : xb00_), _e78);
-            float2 lohi0_ = asfloat(bounds.Load2(_e406*8));
-            const uint _e418 = bounds_index(((bb1_ > floor(bb1_)) ? min((xb10_ + 1u), (width_1 - 1u)) : xb10_), row1_);
-            float2 lohi1_ = asfloat(bounds.Load2(_e418*8));
+            const uint _e418 = bounds_index(((bb0_ > floor(bb0_)) ? min((xb00_ + 1u), (width_1 - 1u)) : xb00_), _e78);
+            float2 lohi0_ = asfloat(bounds.Load2(_e418*8));
+            const uint _e430 = bounds_index(((bb1_ > floor(bb1_)) ? min((xb10_ + 1u), (width_1 - 1u)) : xb10_), row1_);
+            float2 lohi1_ = asfloat(bounds.Load2(_e430*8));
             vis0_ = 0.5;
             vis1_ = 0.5;
-            float _e426 = d;
-            if ((_e426 > lohi0_.x)) {
-                float _e429 = d;
-                local_8 = (_e429 <= lohi0_.y);
+            float _e438 = d;
+            if ((_e438 > lohi0_.x)) {
+                float _e441 = d;
+                local_8 = (_e441 <= lohi0_.y);
             } else {
                 local_8 = false;
             }
-            bool _e435 = local_8;
-            if (!(_e435)) {
-                float _e437 = d;
-                if ((_e437 > lohi1_.x)) {
-                    float _e440 = d;
-                    local_10 = (_e440 <= lohi1_.y);
+            bool _e447 = local_8;
+            if (!(_e447)) {
+                float _e449 = d;
+                if ((_e449 > lohi1_.x)) {
+                    float _e452 = d;
+                    local_10 = (_e452 <= lohi1_.y);
                 } else {
                     local_10 = false;
                 }
-                bool _e446 = local_10;
-                local_9 = _e446;
+                bool _e458 = local_10;
+                local_9 = _e458;
             } else {
                 local_9 = true;
             }
-            bool _e450 = local_9;
-            if (_e450) {
+            bool _e462 = local_9;
+            if (_e462) {
                 layer_4 = 0u;
                 uint2 loop_bound_5 = uint2(4294967295u, 4294967295u);
                 bool loop_init_5 = true;
@@ -859,28 +860,28 @@ float3 scatter_pixel(uint x_6, uint y_1)
                     if (all(loop_bound_5 == uint2(0u, 0u))) { break; }
                     loop_bound_5 -= uint2(loop_bound_5.y == 0u, 1u);
                     if (!loop_init_5) {
-                        uint _e500 = layer_4;
-                        layer_4 = (_e500 + 1u);
+                        uint _e512 = layer_4;
+                        layer_4 = (_e512 + 1u);
                     }
                     loop_init_5 = false;
-                    uint _e453 = layer_4;
-                    if ((_e453 < LAYERS)) {
+                    uint _e465 = layer_4;
+                    if ((_e465 < LAYERS)) {
                     } else {
                         break;
                     }
                     {
-                        uint _e456 = layer_4;
-                        float4 coeff = coeffs[min(uint(_e456), 7u)];
-                        uint _e459 = layer_4;
-                        const float4 _e460 = filtered_load(x00_, _e78, _e459);
-                        uint _e461 = layer_4;
-                        const float4 _e462 = filtered_load(x01_, _e78, _e461);
-                        float4 texel0_ = lerp(_e460, _e462, fx0_);
-                        uint _e464 = layer_4;
-                        const float4 _e465 = filtered_load(x10_, row1_, _e464);
-                        uint _e466 = layer_4;
-                        const float4 _e467 = filtered_load(x11_, row1_, _e466);
-                        float4 texel1_ = lerp(_e465, _e467, fx1_);
+                        uint _e468 = layer_4;
+                        float4 coeff = coeffs[min(uint(_e468), 7u)];
+                        uint _e471 = layer_4;
+                        const float4 _e472 = filtered_load(x00_, _e78, _e471);
+                        uint _e473 = layer_4;
+                        const float4 _e474 = filtered_load(x01_, _e78, _e473);
+                        float4 texel0_ = lerp(_e472, _e474, fx0_);
+                        uint _e476 = layer_4;
+                        const float4 _e477 = filtered_load(x10_, row1_, _e476);
+                        uint _e478 = layer_4;
+                        const float4 _e479 = filtered_load(x11_, row1_, _e478);
+                        float4 texel1_ = lerp(_e477, _e479, fx1_);
                         k_3 = 0u;
                         uint2 loop_bound_6 = uint2(4294967295u, 4294967295u);
                         bool loop_init_6 = true;
@@ -888,93 +889,93 @@ float3 scatter_pixel(uint x_6, uint y_1)
                             if (all(loop_bound_6 == uint2(0u, 0u))) { break; }
                             loop_bound_6 -= uint2(loop_bound_6.y == 0u, 1u);
                             if (!loop_init_6) {
-                                uint _e497 = k_3;
-                                k_3 = (_e497 + 1u);
+                                uint _e509 = k_3;
+                                k_3 = (_e509 + 1u);
                             }
                             loop_init_6 = false;
-                            uint _e471 = k_3;
-                            if ((_e471 < 4u)) {
+                            uint _e483 = k_3;
+                            if ((_e483 < 4u)) {
                             } else {
                                 break;
                             }
                             {
-                                float _e474 = vis0_;
-                                uint _e475 = k_3;
-                                uint _e477 = k_3;
-                                vis0_ = (_e474 + (coeff[min(uint(_e475), 3u)] * ((texel0_[min(uint(_e477), 3u)] * 2.0) - 1.0)));
-                                float _e485 = vis1_;
-                                uint _e486 = k_3;
-                                uint _e488 = k_3;
-                                vis1_ = (_e485 + (coeff[min(uint(_e486), 3u)] * ((texel1_[min(uint(_e488), 3u)] * 2.0) - 1.0)));
+                                float _e486 = vis0_;
+                                uint _e487 = k_3;
+                                uint _e489 = k_3;
+                                vis0_ = (_e486 + (coeff[min(uint(_e487), 3u)] * ((texel0_[min(uint(_e489), 3u)] * 2.0) - 1.0)));
+                                float _e497 = vis1_;
+                                uint _e498 = k_3;
+                                uint _e500 = k_3;
+                                vis1_ = (_e497 + (coeff[min(uint(_e498), 3u)] * ((texel1_[min(uint(_e500), 3u)] * 2.0) - 1.0)));
                             }
                         }
                     }
                 }
             }
-            float _e502 = vis0_;
-            float _e503 = d;
-            float _e508 = d;
-            vis0_ = ((_e508 <= lohi0_.x) ? 1.0 : ((_e503 > lohi0_.y) ? 0.0 : _e502));
-            float _e513 = vis1_;
-            float _e514 = d;
-            float _e519 = d;
-            vis1_ = ((_e519 <= lohi1_.x) ? 1.0 : ((_e514 > lohi1_.y) ? 0.0 : _e513));
-            float _e524 = vis0_;
-            float _e529 = prev0_;
-            vis0_ = (before0_ ? _e529 : clamp(_e524, 0.0, 1.0));
-            float _e531 = vis1_;
-            float _e536 = prev1_;
-            vis1_ = (before1_ ? _e536 : clamp(_e531, 0.0, 1.0));
-            float _e538 = vis0_;
-            prev0_ = _e538;
-            float _e539 = vis1_;
-            prev1_ = _e539;
-            bool _e541 = done0_;
-            if (!(_e541)) {
-                float _e544 = total0_;
-                float _e545 = weight0_;
-                float _e546 = vis0_;
-                total0_ = (_e544 + (_e545 * _e546));
+            float _e514 = vis0_;
+            float _e515 = d;
+            float _e520 = d;
+            vis0_ = ((_e520 <= lohi0_.x) ? 1.0 : ((_e515 > lohi0_.y) ? 0.0 : _e514));
+            float _e525 = vis1_;
+            float _e526 = d;
+            float _e531 = d;
+            vis1_ = ((_e531 <= lohi1_.x) ? 1.0 : ((_e526 > lohi1_.y) ? 0.0 : _e525));
+            float _e536 = vis0_;
+            float _e541 = prev0_;
+            vis0_ = (before0_ ? _e541 : clamp(_e536, 0.0, 1.0));
+            float _e543 = vis1_;
+            float _e548 = prev1_;
+            vis1_ = (before1_ ? _e548 : clamp(_e543, 0.0, 1.0));
+            float _e550 = vis0_;
+            prev0_ = _e550;
+            float _e551 = vis1_;
+            prev1_ = _e551;
+            bool _e553 = done0_;
+            if (!(_e553)) {
+                float _e556 = total0_;
+                float _e557 = weight0_;
+                float _e558 = vis0_;
+                total0_ = (_e556 + (_e557 * _e558));
             }
-            bool _e550 = done1_;
-            if (!(_e550)) {
-                float _e553 = total1_;
-                float _e554 = weight1_;
-                float _e555 = vis1_;
-                total1_ = (_e553 + (_e554 * _e555));
+            bool _e562 = done1_;
+            if (!(_e562)) {
+                float _e565 = total1_;
+                float _e566 = weight1_;
+                float _e567 = vis1_;
+                total1_ = (_e565 + (_e566 * _e567));
             }
-            bool _e558 = done0_;
-            if (!(_e558)) {
+            bool _e570 = done0_;
+            if (!(_e570)) {
                 local_11 = is_last0_;
             } else {
                 local_11 = true;
             }
-            bool _e563 = local_11;
-            done0_ = _e563;
-            bool _e564 = done1_;
-            if (!(_e564)) {
+            bool _e575 = local_11;
+            done0_ = _e575;
+            bool _e576 = done1_;
+            if (!(_e576)) {
                 local_12 = is_last1_;
             } else {
                 local_12 = true;
             }
-            bool _e569 = local_12;
-            done1_ = _e569;
-            bool _e570 = done0_;
-            if (_e570) {
-                bool _e571 = done1_;
-                local_13 = _e571;
+            bool _e581 = local_12;
+            done1_ = _e581;
+            bool _e582 = done0_;
+            if (_e582) {
+                bool _e583 = done1_;
+                local_13 = _e583;
             } else {
                 local_13 = false;
             }
-            bool _e575 = local_13;
-            if (_e575) {
+            bool _e587 = local_13;
+            if (_e587) {
                 break;
             }
         }
     }
-    float _e581 = total0_;
-    float _e583 = total1_;
-    float l_2 = (((1.0 - w1_) * _e581) + (w1_ * _e583));
+    float _e593 = total0_;
+    float _e595 = total1_;
+    float l_2 = (((1.0 - w1_) * _e593) + (w1_ * _e595));
     float3 c = (color * l_2);
     return c;
 }

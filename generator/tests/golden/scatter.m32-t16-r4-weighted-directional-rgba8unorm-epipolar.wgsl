@@ -60,6 +60,7 @@ const GL4_WX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX: vec4<f32> = vec4<f32>(0.347
 const DEPTH_MARGINX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX: f32 = 0.1f;
 const STRIDE: u32 = 1u;
 const REGIONS: u32 = 4u;
+const LOOKUP: u32 = 1u;
 const LAYERS: u32 = 8u;
 
 @group(0) @binding(0) 
@@ -516,7 +517,7 @@ fn scatter_pixel(x_6: u32, y_1: u32) -> vec3<f32> {
     }
     let axis = f_12.axis.xyz;
     let rows_2 = f_12.sizes.w;
-    let width_1 = (f_12.sizes.z / STRIDE);
+    let width_1 = (f_12.sizes.z / LOOKUP);
     let wrap_1 = (f_12.anti_epipole.w > 0.5f);
     {
         theta_3 = atan2(length(cross(_e10, axis)), dot(_e10, axis));
@@ -601,42 +602,42 @@ fn scatter_pixel(x_6: u32, y_1: u32) -> vec3<f32> {
         }
         {
             let _e198 = r_1;
-            let _e199 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e198, REGIONS, width_1, false);
-            let b0_ = f32(_e199);
-            let _e201 = r_1;
-            let _e204 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e201 + 1u), REGIONS, width_1, false);
-            let b1_ = f32(_e204);
+            let _e203 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e198, REGIONS, (f_12.sizes.z / STRIDE), false);
+            let b0_ = f32((1u * _e203));
+            let _e207 = r_1;
+            let _e214 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e207 + 1u), REGIONS, (f_12.sizes.z / STRIDE), false);
+            let b1_ = f32((1u * _e214));
             if !((last0_ < u32(b1_))) {
-                let _e209 = r_1;
-                local_2 = ((_e209 + 1u) == REGIONS);
+                let _e221 = r_1;
+                local_2 = ((_e221 + 1u) == REGIONS);
             } else {
                 local_2 = true;
             }
             let is_last0_ = local_2;
             if !((last1_ < u32(b1_))) {
-                let _e220 = r_1;
-                local_3 = ((_e220 + 1u) == REGIONS);
+                let _e232 = r_1;
+                local_3 = ((_e232 + 1u) == REGIONS);
             } else {
                 local_3 = true;
             }
             let is_last1_ = local_3;
-            let _e230 = xs0_;
-            let pos0_ = select((b1_ - 0.5f), clamp((_e230 - 0.5f), (b0_ + 0.5f), (b1_ - 0.5f)), is_last0_);
-            let _e241 = xs1_;
-            let pos1_ = select((b1_ - 0.5f), clamp((_e241 - 0.5f), (b0_ + 0.5f), (b1_ - 0.5f)), is_last1_);
-            let _e252 = xs0_;
-            let bb0_ = (select((b1_ - 0.5f), clamp((min(_e252, cap0_) - 0.5f), (b0_ + 0.5f), (b1_ - 0.5f)), is_last0_) - 0.5f);
-            let _e266 = xs1_;
-            let bb1_ = (select((b1_ - 0.5f), clamp((min(_e266, cap1_) - 0.5f), (b0_ + 0.5f), (b1_ - 0.5f)), is_last1_) - 0.5f);
+            let _e242 = xs0_;
+            let pos0_ = select((b1_ - 0.5f), clamp((_e242 - 0.5f), (b0_ + 0.5f), (b1_ - 0.5f)), is_last0_);
+            let _e253 = xs1_;
+            let pos1_ = select((b1_ - 0.5f), clamp((_e253 - 0.5f), (b0_ + 0.5f), (b1_ - 0.5f)), is_last1_);
+            let _e264 = xs0_;
+            let bb0_ = (select((b1_ - 0.5f), clamp((min(_e264, cap0_) - 0.5f), (b0_ + 0.5f), (b1_ - 0.5f)), is_last0_) - 0.5f);
+            let _e278 = xs1_;
+            let bb1_ = (select((b1_ - 0.5f), clamp((min(_e278, cap1_) - 0.5f), (b0_ + 0.5f), (b1_ - 0.5f)), is_last1_) - 0.5f);
             if is_last0_ {
                 local_4 = (cap0_ <= b0_);
             } else {
                 local_4 = false;
             }
-            let _e282 = local_4;
-            if _e282 {
-                let _e283 = r_1;
-                local_5 = (_e283 > 0u);
+            let _e294 = local_4;
+            if _e294 {
+                let _e295 = r_1;
+                local_5 = (_e295 > 0u);
             } else {
                 local_5 = false;
             }
@@ -646,10 +647,10 @@ fn scatter_pixel(x_6: u32, y_1: u32) -> vec3<f32> {
             } else {
                 local_6 = false;
             }
-            let _e294 = local_6;
-            if _e294 {
-                let _e295 = r_1;
-                local_7 = (_e295 > 0u);
+            let _e306 = local_6;
+            if _e306 {
+                let _e307 = r_1;
+                local_7 = (_e307 > 0u);
             } else {
                 local_7 = false;
             }
@@ -658,42 +659,42 @@ fn scatter_pixel(x_6: u32, y_1: u32) -> vec3<f32> {
             e0_ = f32();
             a1_ = f32();
             e1_ = f32();
-            let _e310 = delta0_;
-            let _e311 = theta_3;
-            let _e312 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b0_, _e310, _e311, s_3, false);
-            a0_ = _e312;
-            let _e313 = delta0_;
-            let _e314 = theta_3;
-            let _e315 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b1_, _e313, _e314, s_3, false);
-            e0_ = select(_e315, s_3, is_last0_);
-            let _e317 = delta1_;
-            let _e318 = theta_3;
-            let _e319 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b0_, _e317, _e318, s_3, false);
-            a1_ = _e319;
-            let _e320 = delta1_;
-            let _e321 = theta_3;
-            let _e322 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b1_, _e320, _e321, s_3, false);
-            e1_ = select(_e322, s_3, is_last1_);
+            let _e322 = delta0_;
+            let _e323 = theta_3;
+            let _e324 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b0_, _e322, _e323, s_3, false);
+            a0_ = _e324;
+            let _e325 = delta0_;
+            let _e326 = theta_3;
+            let _e327 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b1_, _e325, _e326, s_3, false);
+            e0_ = select(_e327, s_3, is_last0_);
+            let _e329 = delta1_;
+            let _e330 = theta_3;
+            let _e331 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b0_, _e329, _e330, s_3, false);
+            a1_ = _e331;
+            let _e332 = delta1_;
+            let _e333 = theta_3;
+            let _e334 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, b1_, _e332, _e333, s_3, false);
+            e1_ = select(_e334, s_3, is_last1_);
             weight0_ = f32();
             weight1_ = f32();
             if false {
-                let _e328 = a0_;
-                let _e329 = e0_;
-                let _e330 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, _e10, _e328, _e329, panels_2);
-                weight0_ = _e330;
-                let _e331 = a1_;
-                let _e332 = e1_;
-                let _e333 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, _e10, _e331, _e332, panels_2);
-                weight1_ = _e333;
+                let _e340 = a0_;
+                let _e341 = e0_;
+                let _e342 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, _e10, _e340, _e341, panels_2);
+                weight0_ = _e342;
+                let _e343 = a1_;
+                let _e344 = e1_;
+                let _e345 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_12, eye_8, _e10, _e343, _e344, panels_2);
+                weight1_ = _e345;
             } else {
-                let _e336 = a0_;
-                let _e337 = e0_;
-                let _e338 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.x, _e336, _e337);
-                weight0_ = (sun_scatter * _e338);
-                let _e342 = a1_;
-                let _e343 = e1_;
-                let _e344 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.x, _e342, _e343);
-                weight1_ = (sun_scatter * _e344);
+                let _e348 = a0_;
+                let _e349 = e0_;
+                let _e350 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.x, _e348, _e349);
+                weight0_ = (sun_scatter * _e350);
+                let _e354 = a1_;
+                let _e355 = e1_;
+                let _e356 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_12.medium.x, _e354, _e355);
+                weight1_ = (sun_scatter * _e356);
             }
             let xb0_ = (pos0_ - 0.5f);
             let fx0_ = (xb0_ - floor(xb0_));
@@ -705,152 +706,152 @@ fn scatter_pixel(x_6: u32, y_1: u32) -> vec3<f32> {
             let x11_ = select(x10_, min((x10_ + 1u), (width_1 - 1u)), (xb1_ > floor(xb1_)));
             let xb00_ = u32(clamp(floor(bb0_), 0f, (f32(width_1) - 1f)));
             let xb10_ = u32(clamp(floor(bb1_), 0f, (f32(width_1) - 1f)));
-            let _e406 = bounds_index(select(xb00_, min((xb00_ + 1u), (width_1 - 1u)), (bb0_ > floor(bb0_))), _e78);
-            let lohi0_ = bounds[_e406];
-            let _e418 = bounds_index(select(xb10_, min((xb10_ + 1u), (width_1 - 1u)), (bb1_ > floor(bb1_))), row1_);
-            let lohi1_ = bounds[_e418];
+            let _e418 = bounds_index(select(xb00_, min((xb00_ + 1u), (width_1 - 1u)), (bb0_ > floor(bb0_))), _e78);
+            let lohi0_ = bounds[_e418];
+            let _e430 = bounds_index(select(xb10_, min((xb10_ + 1u), (width_1 - 1u)), (bb1_ > floor(bb1_))), row1_);
+            let lohi1_ = bounds[_e430];
             vis0_ = 0.5f;
             vis1_ = 0.5f;
-            let _e426 = d;
-            if (_e426 > lohi0_.x) {
-                let _e429 = d;
-                local_8 = (_e429 <= lohi0_.y);
+            let _e438 = d;
+            if (_e438 > lohi0_.x) {
+                let _e441 = d;
+                local_8 = (_e441 <= lohi0_.y);
             } else {
                 local_8 = false;
             }
-            let _e435 = local_8;
-            if !(_e435) {
-                let _e437 = d;
-                if (_e437 > lohi1_.x) {
-                    let _e440 = d;
-                    local_10 = (_e440 <= lohi1_.y);
+            let _e447 = local_8;
+            if !(_e447) {
+                let _e449 = d;
+                if (_e449 > lohi1_.x) {
+                    let _e452 = d;
+                    local_10 = (_e452 <= lohi1_.y);
                 } else {
                     local_10 = false;
                 }
-                let _e446 = local_10;
-                local_9 = _e446;
+                let _e458 = local_10;
+                local_9 = _e458;
             } else {
                 local_9 = true;
             }
-            let _e450 = local_9;
-            if _e450 {
+            let _e462 = local_9;
+            if _e462 {
                 layer_4 = 0u;
                 loop {
-                    let _e453 = layer_4;
-                    if (_e453 < LAYERS) {
+                    let _e465 = layer_4;
+                    if (_e465 < LAYERS) {
                     } else {
                         break;
                     }
                     {
-                        let _e456 = layer_4;
-                        let coeff = coeffs[_e456];
-                        let _e459 = layer_4;
-                        let _e460 = filtered_load(x00_, _e78, _e459);
-                        let _e461 = layer_4;
-                        let _e462 = filtered_load(x01_, _e78, _e461);
-                        let texel0_ = mix(_e460, _e462, fx0_);
-                        let _e464 = layer_4;
-                        let _e465 = filtered_load(x10_, row1_, _e464);
-                        let _e466 = layer_4;
-                        let _e467 = filtered_load(x11_, row1_, _e466);
-                        let texel1_ = mix(_e465, _e467, fx1_);
+                        let _e468 = layer_4;
+                        let coeff = coeffs[_e468];
+                        let _e471 = layer_4;
+                        let _e472 = filtered_load(x00_, _e78, _e471);
+                        let _e473 = layer_4;
+                        let _e474 = filtered_load(x01_, _e78, _e473);
+                        let texel0_ = mix(_e472, _e474, fx0_);
+                        let _e476 = layer_4;
+                        let _e477 = filtered_load(x10_, row1_, _e476);
+                        let _e478 = layer_4;
+                        let _e479 = filtered_load(x11_, row1_, _e478);
+                        let texel1_ = mix(_e477, _e479, fx1_);
                         k_3 = 0u;
                         loop {
-                            let _e471 = k_3;
-                            if (_e471 < 4u) {
+                            let _e483 = k_3;
+                            if (_e483 < 4u) {
                             } else {
                                 break;
                             }
                             {
-                                let _e474 = vis0_;
-                                let _e475 = k_3;
-                                let _e477 = k_3;
-                                vis0_ = (_e474 + (coeff[_e475] * ((texel0_[_e477] * 2f) - 1f)));
-                                let _e485 = vis1_;
-                                let _e486 = k_3;
-                                let _e488 = k_3;
-                                vis1_ = (_e485 + (coeff[_e486] * ((texel1_[_e488] * 2f) - 1f)));
+                                let _e486 = vis0_;
+                                let _e487 = k_3;
+                                let _e489 = k_3;
+                                vis0_ = (_e486 + (coeff[_e487] * ((texel0_[_e489] * 2f) - 1f)));
+                                let _e497 = vis1_;
+                                let _e498 = k_3;
+                                let _e500 = k_3;
+                                vis1_ = (_e497 + (coeff[_e498] * ((texel1_[_e500] * 2f) - 1f)));
                             }
                             continuing {
-                                let _e497 = k_3;
-                                k_3 = (_e497 + 1u);
+                                let _e509 = k_3;
+                                k_3 = (_e509 + 1u);
                             }
                         }
                     }
                     continuing {
-                        let _e500 = layer_4;
-                        layer_4 = (_e500 + 1u);
+                        let _e512 = layer_4;
+                        layer_4 = (_e512 + 1u);
                     }
                 }
             }
-            let _e502 = vis0_;
-            let _e503 = d;
-            let _e508 = d;
-            vis0_ = select(select(_e502, 0f, (_e503 > lohi0_.y)), 1f, (_e508 <= lohi0_.x));
-            let _e513 = vis1_;
-            let _e514 = d;
-            let _e519 = d;
-            vis1_ = select(select(_e513, 0f, (_e514 > lohi1_.y)), 1f, (_e519 <= lohi1_.x));
-            let _e524 = vis0_;
-            let _e529 = prev0_;
-            vis0_ = select(clamp(_e524, 0f, 1f), _e529, before0_);
-            let _e531 = vis1_;
-            let _e536 = prev1_;
-            vis1_ = select(clamp(_e531, 0f, 1f), _e536, before1_);
-            let _e538 = vis0_;
-            prev0_ = _e538;
-            let _e539 = vis1_;
-            prev1_ = _e539;
-            let _e541 = done0_;
-            if !(_e541) {
-                let _e544 = total0_;
-                let _e545 = weight0_;
-                let _e546 = vis0_;
-                total0_ = (_e544 + (_e545 * _e546));
+            let _e514 = vis0_;
+            let _e515 = d;
+            let _e520 = d;
+            vis0_ = select(select(_e514, 0f, (_e515 > lohi0_.y)), 1f, (_e520 <= lohi0_.x));
+            let _e525 = vis1_;
+            let _e526 = d;
+            let _e531 = d;
+            vis1_ = select(select(_e525, 0f, (_e526 > lohi1_.y)), 1f, (_e531 <= lohi1_.x));
+            let _e536 = vis0_;
+            let _e541 = prev0_;
+            vis0_ = select(clamp(_e536, 0f, 1f), _e541, before0_);
+            let _e543 = vis1_;
+            let _e548 = prev1_;
+            vis1_ = select(clamp(_e543, 0f, 1f), _e548, before1_);
+            let _e550 = vis0_;
+            prev0_ = _e550;
+            let _e551 = vis1_;
+            prev1_ = _e551;
+            let _e553 = done0_;
+            if !(_e553) {
+                let _e556 = total0_;
+                let _e557 = weight0_;
+                let _e558 = vis0_;
+                total0_ = (_e556 + (_e557 * _e558));
             }
-            let _e550 = done1_;
-            if !(_e550) {
-                let _e553 = total1_;
-                let _e554 = weight1_;
-                let _e555 = vis1_;
-                total1_ = (_e553 + (_e554 * _e555));
+            let _e562 = done1_;
+            if !(_e562) {
+                let _e565 = total1_;
+                let _e566 = weight1_;
+                let _e567 = vis1_;
+                total1_ = (_e565 + (_e566 * _e567));
             }
-            let _e558 = done0_;
-            if !(_e558) {
+            let _e570 = done0_;
+            if !(_e570) {
                 local_11 = is_last0_;
             } else {
                 local_11 = true;
             }
-            let _e563 = local_11;
-            done0_ = _e563;
-            let _e564 = done1_;
-            if !(_e564) {
+            let _e575 = local_11;
+            done0_ = _e575;
+            let _e576 = done1_;
+            if !(_e576) {
                 local_12 = is_last1_;
             } else {
                 local_12 = true;
             }
-            let _e569 = local_12;
-            done1_ = _e569;
-            let _e570 = done0_;
-            if _e570 {
-                let _e571 = done1_;
-                local_13 = _e571;
+            let _e581 = local_12;
+            done1_ = _e581;
+            let _e582 = done0_;
+            if _e582 {
+                let _e583 = done1_;
+                local_13 = _e583;
             } else {
                 local_13 = false;
             }
-            let _e575 = local_13;
-            if _e575 {
+            let _e587 = local_13;
+            if _e587 {
                 break;
             }
         }
         continuing {
-            let _e577 = r_1;
-            r_1 = (_e577 + 1u);
+            let _e589 = r_1;
+            r_1 = (_e589 + 1u);
         }
     }
-    let _e581 = total0_;
-    let _e583 = total1_;
-    let l_2 = (((1f - w1_) * _e581) + (w1_ * _e583));
+    let _e593 = total0_;
+    let _e595 = total1_;
+    let l_2 = (((1f - w1_) * _e593) + (w1_ * _e595));
     let c = (color * l_2);
     return c;
 }

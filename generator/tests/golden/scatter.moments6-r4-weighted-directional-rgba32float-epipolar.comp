@@ -69,6 +69,7 @@ const float FAR_ROOTX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX = 10000.0;
 const float MOMENT_SPLITX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX = 0.5;
 const uint STRIDE = 1u;
 const uint REGIONS = 4u;
+const uint LOOKUP = 1u;
 
 layout(std140, binding = 0) uniform FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX_block_0Compute { FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX _group_0_binding_0_cs; };
 
@@ -646,7 +647,7 @@ vec3 scatter_pixel(uint x_9, uint y_1) {
     }
     vec3 axis = f_13.axis.xyz;
     uint rows_2 = f_13.sizes.w;
-    uint width_1 = (f_13.sizes.z / STRIDE);
+    uint width_1 = (f_13.sizes.z / LOOKUP);
     bool wrap_1 = (f_13.anti_epipole.w > 0.5);
     {
         theta_3 = atan(length(cross(_e10, axis)), dot(_e10, axis));
@@ -699,8 +700,8 @@ vec3 scatter_pixel(uint x_9, uint y_1) {
     bool loop_init_4 = true;
     while(true) {
         if (!loop_init_4) {
-            uint _e535 = r_1;
-            r_1 = (_e535 + 1u);
+            uint _e555 = r_1;
+            r_1 = (_e555 + 1u);
         }
         loop_init_4 = false;
         uint _e168 = r_1;
@@ -710,42 +711,42 @@ vec3 scatter_pixel(uint x_9, uint y_1) {
         }
         {
             uint _e170 = r_1;
-            uint _e171 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e170, REGIONS, width_1, false);
-            float b0_ = float(_e171);
-            uint _e173 = r_1;
-            uint _e176 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e173 + 1u), REGIONS, width_1, false);
-            float b1_2 = float(_e176);
+            uint _e175 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e170, REGIONS, (f_13.sizes.z / STRIDE), false);
+            float b0_ = float((1u * _e175));
+            uint _e179 = r_1;
+            uint _e186 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e179 + 1u), REGIONS, (f_13.sizes.z / STRIDE), false);
+            float b1_2 = float((1u * _e186));
             if (!((last0_ < uint(b1_2)))) {
-                uint _e181 = r_1;
-                local_3 = ((_e181 + 1u) == REGIONS);
+                uint _e193 = r_1;
+                local_3 = ((_e193 + 1u) == REGIONS);
             } else {
                 local_3 = true;
             }
             bool is_last0_ = local_3;
             if (!((last1_ < uint(b1_2)))) {
-                uint _e192 = r_1;
-                local_4 = ((_e192 + 1u) == REGIONS);
+                uint _e204 = r_1;
+                local_4 = ((_e204 + 1u) == REGIONS);
             } else {
                 local_4 = true;
             }
             bool is_last1_ = local_4;
-            float _e202 = xs0_;
-            float pos0_ = (is_last0_ ? clamp((_e202 - 0.5), (b0_ + 0.5), (b1_2 - 0.5)) : (b1_2 - 0.5));
-            float _e213 = xs1_;
-            float pos1_ = (is_last1_ ? clamp((_e213 - 0.5), (b0_ + 0.5), (b1_2 - 0.5)) : (b1_2 - 0.5));
-            float _e224 = xs0_;
-            float bb0_ = ((is_last0_ ? clamp((min(_e224, cap0_) - 0.5), (b0_ + 0.5), (b1_2 - 0.5)) : (b1_2 - 0.5)) - 0.5);
-            float _e238 = xs1_;
-            float bb1_ = ((is_last1_ ? clamp((min(_e238, cap1_) - 0.5), (b0_ + 0.5), (b1_2 - 0.5)) : (b1_2 - 0.5)) - 0.5);
+            float _e214 = xs0_;
+            float pos0_ = (is_last0_ ? clamp((_e214 - 0.5), (b0_ + 0.5), (b1_2 - 0.5)) : (b1_2 - 0.5));
+            float _e225 = xs1_;
+            float pos1_ = (is_last1_ ? clamp((_e225 - 0.5), (b0_ + 0.5), (b1_2 - 0.5)) : (b1_2 - 0.5));
+            float _e236 = xs0_;
+            float bb0_ = ((is_last0_ ? clamp((min(_e236, cap0_) - 0.5), (b0_ + 0.5), (b1_2 - 0.5)) : (b1_2 - 0.5)) - 0.5);
+            float _e250 = xs1_;
+            float bb1_ = ((is_last1_ ? clamp((min(_e250, cap1_) - 0.5), (b0_ + 0.5), (b1_2 - 0.5)) : (b1_2 - 0.5)) - 0.5);
             if (is_last0_) {
                 local_5 = (cap0_ <= b0_);
             } else {
                 local_5 = false;
             }
-            bool _e254 = local_5;
-            if (_e254) {
-                uint _e255 = r_1;
-                local_6 = (_e255 > 0u);
+            bool _e266 = local_5;
+            if (_e266) {
+                uint _e267 = r_1;
+                local_6 = (_e267 > 0u);
             } else {
                 local_6 = false;
             }
@@ -755,10 +756,10 @@ vec3 scatter_pixel(uint x_9, uint y_1) {
             } else {
                 local_7 = false;
             }
-            bool _e266 = local_7;
-            if (_e266) {
-                uint _e267 = r_1;
-                local_8 = (_e267 > 0u);
+            bool _e278 = local_7;
+            if (_e278) {
+                uint _e279 = r_1;
+                local_8 = (_e279 > 0u);
             } else {
                 local_8 = false;
             }
@@ -767,42 +768,42 @@ vec3 scatter_pixel(uint x_9, uint y_1) {
             e0_ = 0.0;
             a1_ = 0.0;
             e1_ = 0.0;
-            float _e282 = delta0_;
-            float _e283 = theta_3;
-            float _e284 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b0_, _e282, _e283, s_5, false);
-            a0_ = _e284;
-            float _e285 = delta0_;
-            float _e286 = theta_3;
-            float _e287 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b1_2, _e285, _e286, s_5, false);
-            e0_ = (is_last0_ ? s_5 : _e287);
-            float _e289 = delta1_;
-            float _e290 = theta_3;
-            float _e291 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b0_, _e289, _e290, s_5, false);
-            a1_ = _e291;
-            float _e292 = delta1_;
-            float _e293 = theta_3;
-            float _e294 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b1_2, _e292, _e293, s_5, false);
-            e1_ = (is_last1_ ? s_5 : _e294);
+            float _e294 = delta0_;
+            float _e295 = theta_3;
+            float _e296 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b0_, _e294, _e295, s_5, false);
+            a0_ = _e296;
+            float _e297 = delta0_;
+            float _e298 = theta_3;
+            float _e299 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b1_2, _e297, _e298, s_5, false);
+            e0_ = (is_last0_ ? s_5 : _e299);
+            float _e301 = delta1_;
+            float _e302 = theta_3;
+            float _e303 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b0_, _e301, _e302, s_5, false);
+            a1_ = _e303;
+            float _e304 = delta1_;
+            float _e305 = theta_3;
+            float _e306 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b1_2, _e304, _e305, s_5, false);
+            e1_ = (is_last1_ ? s_5 : _e306);
             weight0_ = 0.0;
             weight1_ = 0.0;
             if (false) {
-                float _e300 = a0_;
-                float _e301 = e0_;
-                float _e302 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, _e10, _e300, _e301, panels_2);
-                weight0_ = _e302;
-                float _e303 = a1_;
-                float _e304 = e1_;
-                float _e305 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, _e10, _e303, _e304, panels_2);
-                weight1_ = _e305;
+                float _e312 = a0_;
+                float _e313 = e0_;
+                float _e314 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, _e10, _e312, _e313, panels_2);
+                weight0_ = _e314;
+                float _e315 = a1_;
+                float _e316 = e1_;
+                float _e317 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, _e10, _e315, _e316, panels_2);
+                weight1_ = _e317;
             } else {
-                float _e308 = a0_;
-                float _e309 = e0_;
-                float _e310 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.x, _e308, _e309);
-                weight0_ = (sun_scatter * _e310);
-                float _e314 = a1_;
-                float _e315 = e1_;
-                float _e316 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.x, _e314, _e315);
-                weight1_ = (sun_scatter * _e316);
+                float _e320 = a0_;
+                float _e321 = e0_;
+                float _e322 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.x, _e320, _e321);
+                weight0_ = (sun_scatter * _e322);
+                float _e326 = a1_;
+                float _e327 = e1_;
+                float _e328 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.x, _e326, _e327);
+                weight1_ = (sun_scatter * _e328);
             }
             float xb0_ = (pos0_ - 0.5);
             float fx0_ = (xb0_ - floor(xb0_));
@@ -814,120 +815,120 @@ vec3 scatter_pixel(uint x_9, uint y_1) {
             uint x11_ = ((xb1_ > floor(xb1_)) ? min((x10_ + 1u), (width_1 - 1u)) : x10_);
             uint xb00_ = uint(clamp(floor(bb0_), 0.0, (float(width_1) - 1.0)));
             uint xb10_ = uint(clamp(floor(bb1_), 0.0, (float(width_1) - 1.0)));
-            uint _e378 = bounds_index(((bb0_ > floor(bb0_)) ? min((xb00_ + 1u), (width_1 - 1u)) : xb00_), _e78);
-            vec2 lohi0_ = _group_0_binding_6_cs[_e378];
-            uint _e390 = bounds_index(((bb1_ > floor(bb1_)) ? min((xb10_ + 1u), (width_1 - 1u)) : xb10_), row1_);
-            vec2 lohi1_ = _group_0_binding_6_cs[_e390];
+            uint _e390 = bounds_index(((bb0_ > floor(bb0_)) ? min((xb00_ + 1u), (width_1 - 1u)) : xb00_), _e78);
+            vec2 lohi0_ = _group_0_binding_6_cs[_e390];
+            uint _e402 = bounds_index(((bb1_ > floor(bb1_)) ? min((xb10_ + 1u), (width_1 - 1u)) : xb10_), row1_);
+            vec2 lohi1_ = _group_0_binding_6_cs[_e402];
             vis0_ = 0.5;
             vis1_ = 0.5;
-            float _e398 = d_1;
-            if ((_e398 > lohi0_.x)) {
-                float _e401 = d_1;
-                local_9 = (_e401 <= lohi0_.y);
+            float _e410 = d_1;
+            if ((_e410 > lohi0_.x)) {
+                float _e413 = d_1;
+                local_9 = (_e413 <= lohi0_.y);
             } else {
                 local_9 = false;
             }
-            bool _e407 = local_9;
-            if (_e407) {
-                float _e408 = d_1;
-                uint _e412 = bounds_index((uint(b1_2) - 1u), _e78);
-                vec2 _e415 = _group_0_binding_6_cs[_e412];
-                float _e416 = moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(_e408, _e415);
-                vec4 _e418 = filtered_load(x00_, _e78, 0u);
-                vec4 _e420 = filtered_load(x01_, _e78, 0u);
-                vec4 m0_ = mix(_e418, _e420, fx0_);
-                vec4 _e423 = filtered_load(x00_, _e78, 1u);
-                vec4 _e425 = filtered_load(x01_, _e78, 1u);
-                vec4 m1_ = mix(_e423, _e425, fx0_);
-                float _e428 = lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(m0_, m1_.xy, _e416);
-                vis0_ = _e428;
+            bool _e419 = local_9;
+            if (_e419) {
+                uint _e427 = bounds_index((((uint(b1_2) * LOOKUP) / STRIDE) - 1u), _e78);
+                vec2 range0_ = _group_0_binding_6_cs[_e427];
+                float _e431 = d_1;
+                float _e432 = moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(_e431, range0_);
+                vec4 _e434 = filtered_load(x00_, _e78, 0u);
+                vec4 _e436 = filtered_load(x01_, _e78, 0u);
+                vec4 m0_ = mix(_e434, _e436, fx0_);
+                vec4 _e439 = filtered_load(x00_, _e78, 1u);
+                vec4 _e441 = filtered_load(x01_, _e78, 1u);
+                vec4 m1_ = mix(_e439, _e441, fx0_);
+                float _e444 = lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(m0_, m1_.xy, _e432);
+                vis0_ = _e444;
             }
-            float _e429 = d_1;
-            if ((_e429 > lohi1_.x)) {
-                float _e432 = d_1;
-                local_10 = (_e432 <= lohi1_.y);
+            float _e445 = d_1;
+            if ((_e445 > lohi1_.x)) {
+                float _e448 = d_1;
+                local_10 = (_e448 <= lohi1_.y);
             } else {
                 local_10 = false;
             }
-            bool _e438 = local_10;
-            if (_e438) {
-                float _e439 = d_1;
-                uint _e443 = bounds_index((uint(b1_2) - 1u), row1_);
-                vec2 _e446 = _group_0_binding_6_cs[_e443];
-                float _e447 = moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(_e439, _e446);
-                vec4 _e449 = filtered_load(x10_, row1_, 0u);
-                vec4 _e451 = filtered_load(x11_, row1_, 0u);
-                vec4 m0_1 = mix(_e449, _e451, fx1_);
-                vec4 _e454 = filtered_load(x10_, row1_, 1u);
-                vec4 _e456 = filtered_load(x11_, row1_, 1u);
-                vec4 m1_1 = mix(_e454, _e456, fx1_);
-                float _e459 = lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(m0_1, m1_1.xy, _e447);
-                vis1_ = _e459;
+            bool _e454 = local_10;
+            if (_e454) {
+                uint _e462 = bounds_index((((uint(b1_2) * LOOKUP) / STRIDE) - 1u), row1_);
+                vec2 range1_ = _group_0_binding_6_cs[_e462];
+                float _e466 = d_1;
+                float _e467 = moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(_e466, range1_);
+                vec4 _e469 = filtered_load(x10_, row1_, 0u);
+                vec4 _e471 = filtered_load(x11_, row1_, 0u);
+                vec4 m0_1 = mix(_e469, _e471, fx1_);
+                vec4 _e474 = filtered_load(x10_, row1_, 1u);
+                vec4 _e476 = filtered_load(x11_, row1_, 1u);
+                vec4 m1_1 = mix(_e474, _e476, fx1_);
+                float _e479 = lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(m0_1, m1_1.xy, _e467);
+                vis1_ = _e479;
             }
-            float _e460 = vis0_;
-            float _e461 = d_1;
-            float _e466 = d_1;
-            vis0_ = ((_e466 <= lohi0_.x) ? 1.0 : ((_e461 > lohi0_.y) ? 0.0 : _e460));
-            float _e471 = vis1_;
-            float _e472 = d_1;
-            float _e477 = d_1;
-            vis1_ = ((_e477 <= lohi1_.x) ? 1.0 : ((_e472 > lohi1_.y) ? 0.0 : _e471));
-            float _e482 = vis0_;
-            float _e487 = prev0_;
-            vis0_ = (before0_ ? _e487 : clamp(_e482, 0.0, 1.0));
-            float _e489 = vis1_;
-            float _e494 = prev1_;
-            vis1_ = (before1_ ? _e494 : clamp(_e489, 0.0, 1.0));
-            float _e496 = vis0_;
-            prev0_ = _e496;
-            float _e497 = vis1_;
-            prev1_ = _e497;
-            bool _e499 = done0_;
-            if (!(_e499)) {
-                float _e502 = total0_;
-                float _e503 = weight0_;
-                float _e504 = vis0_;
-                total0_ = (_e502 + (_e503 * _e504));
+            float _e480 = vis0_;
+            float _e481 = d_1;
+            float _e486 = d_1;
+            vis0_ = ((_e486 <= lohi0_.x) ? 1.0 : ((_e481 > lohi0_.y) ? 0.0 : _e480));
+            float _e491 = vis1_;
+            float _e492 = d_1;
+            float _e497 = d_1;
+            vis1_ = ((_e497 <= lohi1_.x) ? 1.0 : ((_e492 > lohi1_.y) ? 0.0 : _e491));
+            float _e502 = vis0_;
+            float _e507 = prev0_;
+            vis0_ = (before0_ ? _e507 : clamp(_e502, 0.0, 1.0));
+            float _e509 = vis1_;
+            float _e514 = prev1_;
+            vis1_ = (before1_ ? _e514 : clamp(_e509, 0.0, 1.0));
+            float _e516 = vis0_;
+            prev0_ = _e516;
+            float _e517 = vis1_;
+            prev1_ = _e517;
+            bool _e519 = done0_;
+            if (!(_e519)) {
+                float _e522 = total0_;
+                float _e523 = weight0_;
+                float _e524 = vis0_;
+                total0_ = (_e522 + (_e523 * _e524));
             }
-            bool _e508 = done1_;
-            if (!(_e508)) {
-                float _e511 = total1_;
-                float _e512 = weight1_;
-                float _e513 = vis1_;
-                total1_ = (_e511 + (_e512 * _e513));
+            bool _e528 = done1_;
+            if (!(_e528)) {
+                float _e531 = total1_;
+                float _e532 = weight1_;
+                float _e533 = vis1_;
+                total1_ = (_e531 + (_e532 * _e533));
             }
-            bool _e516 = done0_;
-            if (!(_e516)) {
+            bool _e536 = done0_;
+            if (!(_e536)) {
                 local_11 = is_last0_;
             } else {
                 local_11 = true;
             }
-            bool _e521 = local_11;
-            done0_ = _e521;
-            bool _e522 = done1_;
-            if (!(_e522)) {
+            bool _e541 = local_11;
+            done0_ = _e541;
+            bool _e542 = done1_;
+            if (!(_e542)) {
                 local_12 = is_last1_;
             } else {
                 local_12 = true;
             }
-            bool _e527 = local_12;
-            done1_ = _e527;
-            bool _e528 = done0_;
-            if (_e528) {
-                bool _e529 = done1_;
-                local_13 = _e529;
+            bool _e547 = local_12;
+            done1_ = _e547;
+            bool _e548 = done0_;
+            if (_e548) {
+                bool _e549 = done1_;
+                local_13 = _e549;
             } else {
                 local_13 = false;
             }
-            bool _e533 = local_13;
-            if (_e533) {
+            bool _e553 = local_13;
+            if (_e553) {
                 break;
             }
         }
     }
-    float _e539 = total0_;
-    float _e541 = total1_;
-    float l_2 = (((1.0 - w1_) * _e539) + (w1_ * _e541));
+    float _e559 = total0_;
+    float _e561 = total1_;
+    float l_2 = (((1.0 - w1_) * _e559) + (w1_ * _e561));
     vec3 c_1 = (color * l_2);
     return c_1;
 }

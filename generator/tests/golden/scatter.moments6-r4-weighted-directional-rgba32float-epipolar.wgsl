@@ -69,6 +69,7 @@ const FAR_ROOTX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX: f32 = 10000f;
 const MOMENT_SPLITX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX: f32 = 0.5f;
 const STRIDE: u32 = 1u;
 const REGIONS: u32 = 4u;
+const LOOKUP: u32 = 1u;
 
 @group(0) @binding(0) 
 var<uniform> frame: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX;
@@ -642,7 +643,7 @@ fn scatter_pixel(x_9: u32, y_1: u32) -> vec3<f32> {
     }
     let axis = f_13.axis.xyz;
     let rows_2 = f_13.sizes.w;
-    let width_1 = (f_13.sizes.z / STRIDE);
+    let width_1 = (f_13.sizes.z / LOOKUP);
     let wrap_1 = (f_13.anti_epipole.w > 0.5f);
     {
         theta_3 = atan2(length(cross(_e10, axis)), dot(_e10, axis));
@@ -700,42 +701,42 @@ fn scatter_pixel(x_9: u32, y_1: u32) -> vec3<f32> {
         }
         {
             let _e170 = r_1;
-            let _e171 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e170, REGIONS, width_1, false);
-            let b0_ = f32(_e171);
-            let _e173 = r_1;
-            let _e176 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e173 + 1u), REGIONS, width_1, false);
-            let b1_2 = f32(_e176);
+            let _e175 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX(_e170, REGIONS, (f_13.sizes.z / STRIDE), false);
+            let b0_ = f32((1u * _e175));
+            let _e179 = r_1;
+            let _e186 = region_startX_naga_oil_mod_XONRWC5DUMVZDUOTQOJSWM2LMORSXEZLEX((_e179 + 1u), REGIONS, (f_13.sizes.z / STRIDE), false);
+            let b1_2 = f32((1u * _e186));
             if !((last0_ < u32(b1_2))) {
-                let _e181 = r_1;
-                local_3 = ((_e181 + 1u) == REGIONS);
+                let _e193 = r_1;
+                local_3 = ((_e193 + 1u) == REGIONS);
             } else {
                 local_3 = true;
             }
             let is_last0_ = local_3;
             if !((last1_ < u32(b1_2))) {
-                let _e192 = r_1;
-                local_4 = ((_e192 + 1u) == REGIONS);
+                let _e204 = r_1;
+                local_4 = ((_e204 + 1u) == REGIONS);
             } else {
                 local_4 = true;
             }
             let is_last1_ = local_4;
-            let _e202 = xs0_;
-            let pos0_ = select((b1_2 - 0.5f), clamp((_e202 - 0.5f), (b0_ + 0.5f), (b1_2 - 0.5f)), is_last0_);
-            let _e213 = xs1_;
-            let pos1_ = select((b1_2 - 0.5f), clamp((_e213 - 0.5f), (b0_ + 0.5f), (b1_2 - 0.5f)), is_last1_);
-            let _e224 = xs0_;
-            let bb0_ = (select((b1_2 - 0.5f), clamp((min(_e224, cap0_) - 0.5f), (b0_ + 0.5f), (b1_2 - 0.5f)), is_last0_) - 0.5f);
-            let _e238 = xs1_;
-            let bb1_ = (select((b1_2 - 0.5f), clamp((min(_e238, cap1_) - 0.5f), (b0_ + 0.5f), (b1_2 - 0.5f)), is_last1_) - 0.5f);
+            let _e214 = xs0_;
+            let pos0_ = select((b1_2 - 0.5f), clamp((_e214 - 0.5f), (b0_ + 0.5f), (b1_2 - 0.5f)), is_last0_);
+            let _e225 = xs1_;
+            let pos1_ = select((b1_2 - 0.5f), clamp((_e225 - 0.5f), (b0_ + 0.5f), (b1_2 - 0.5f)), is_last1_);
+            let _e236 = xs0_;
+            let bb0_ = (select((b1_2 - 0.5f), clamp((min(_e236, cap0_) - 0.5f), (b0_ + 0.5f), (b1_2 - 0.5f)), is_last0_) - 0.5f);
+            let _e250 = xs1_;
+            let bb1_ = (select((b1_2 - 0.5f), clamp((min(_e250, cap1_) - 0.5f), (b0_ + 0.5f), (b1_2 - 0.5f)), is_last1_) - 0.5f);
             if is_last0_ {
                 local_5 = (cap0_ <= b0_);
             } else {
                 local_5 = false;
             }
-            let _e254 = local_5;
-            if _e254 {
-                let _e255 = r_1;
-                local_6 = (_e255 > 0u);
+            let _e266 = local_5;
+            if _e266 {
+                let _e267 = r_1;
+                local_6 = (_e267 > 0u);
             } else {
                 local_6 = false;
             }
@@ -745,10 +746,10 @@ fn scatter_pixel(x_9: u32, y_1: u32) -> vec3<f32> {
             } else {
                 local_7 = false;
             }
-            let _e266 = local_7;
-            if _e266 {
-                let _e267 = r_1;
-                local_8 = (_e267 > 0u);
+            let _e278 = local_7;
+            if _e278 {
+                let _e279 = r_1;
+                local_8 = (_e279 > 0u);
             } else {
                 local_8 = false;
             }
@@ -757,42 +758,42 @@ fn scatter_pixel(x_9: u32, y_1: u32) -> vec3<f32> {
             e0_ = f32();
             a1_ = f32();
             e1_ = f32();
-            let _e282 = delta0_;
-            let _e283 = theta_3;
-            let _e284 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b0_, _e282, _e283, s_5, false);
-            a0_ = _e284;
-            let _e285 = delta0_;
-            let _e286 = theta_3;
-            let _e287 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b1_2, _e285, _e286, s_5, false);
-            e0_ = select(_e287, s_5, is_last0_);
-            let _e289 = delta1_;
-            let _e290 = theta_3;
-            let _e291 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b0_, _e289, _e290, s_5, false);
-            a1_ = _e291;
-            let _e292 = delta1_;
-            let _e293 = theta_3;
-            let _e294 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b1_2, _e292, _e293, s_5, false);
-            e1_ = select(_e294, s_5, is_last1_);
+            let _e294 = delta0_;
+            let _e295 = theta_3;
+            let _e296 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b0_, _e294, _e295, s_5, false);
+            a0_ = _e296;
+            let _e297 = delta0_;
+            let _e298 = theta_3;
+            let _e299 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b1_2, _e297, _e298, s_5, false);
+            e0_ = select(_e299, s_5, is_last0_);
+            let _e301 = delta1_;
+            let _e302 = theta_3;
+            let _e303 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b0_, _e301, _e302, s_5, false);
+            a1_ = _e303;
+            let _e304 = delta1_;
+            let _e305 = theta_3;
+            let _e306 = ray_tX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, b1_2, _e304, _e305, s_5, false);
+            e1_ = select(_e306, s_5, is_last1_);
             weight0_ = f32();
             weight1_ = f32();
             if false {
-                let _e300 = a0_;
-                let _e301 = e0_;
-                let _e302 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, _e10, _e300, _e301, panels_2);
-                weight0_ = _e302;
-                let _e303 = a1_;
-                let _e304 = e1_;
-                let _e305 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, _e10, _e303, _e304, panels_2);
-                weight1_ = _e305;
+                let _e312 = a0_;
+                let _e313 = e0_;
+                let _e314 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, _e10, _e312, _e313, panels_2);
+                weight0_ = _e314;
+                let _e315 = a1_;
+                let _e316 = e1_;
+                let _e317 = spot_segmentX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX(f_13, eye_8, _e10, _e315, _e316, panels_2);
+                weight1_ = _e317;
             } else {
-                let _e308 = a0_;
-                let _e309 = e0_;
-                let _e310 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.x, _e308, _e309);
-                weight0_ = (sun_scatter * _e310);
-                let _e314 = a1_;
-                let _e315 = e1_;
-                let _e316 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.x, _e314, _e315);
-                weight1_ = (sun_scatter * _e316);
+                let _e320 = a0_;
+                let _e321 = e0_;
+                let _e322 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.x, _e320, _e321);
+                weight0_ = (sun_scatter * _e322);
+                let _e326 = a1_;
+                let _e327 = e1_;
+                let _e328 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(f_13.medium.x, _e326, _e327);
+                weight1_ = (sun_scatter * _e328);
             }
             let xb0_ = (pos0_ - 0.5f);
             let fx0_ = (xb0_ - floor(xb0_));
@@ -804,124 +805,124 @@ fn scatter_pixel(x_9: u32, y_1: u32) -> vec3<f32> {
             let x11_ = select(x10_, min((x10_ + 1u), (width_1 - 1u)), (xb1_ > floor(xb1_)));
             let xb00_ = u32(clamp(floor(bb0_), 0f, (f32(width_1) - 1f)));
             let xb10_ = u32(clamp(floor(bb1_), 0f, (f32(width_1) - 1f)));
-            let _e378 = bounds_index(select(xb00_, min((xb00_ + 1u), (width_1 - 1u)), (bb0_ > floor(bb0_))), _e78);
-            let lohi0_ = bounds[_e378];
-            let _e390 = bounds_index(select(xb10_, min((xb10_ + 1u), (width_1 - 1u)), (bb1_ > floor(bb1_))), row1_);
-            let lohi1_ = bounds[_e390];
+            let _e390 = bounds_index(select(xb00_, min((xb00_ + 1u), (width_1 - 1u)), (bb0_ > floor(bb0_))), _e78);
+            let lohi0_ = bounds[_e390];
+            let _e402 = bounds_index(select(xb10_, min((xb10_ + 1u), (width_1 - 1u)), (bb1_ > floor(bb1_))), row1_);
+            let lohi1_ = bounds[_e402];
             vis0_ = 0.5f;
             vis1_ = 0.5f;
-            let _e398 = d_1;
-            if (_e398 > lohi0_.x) {
-                let _e401 = d_1;
-                local_9 = (_e401 <= lohi0_.y);
+            let _e410 = d_1;
+            if (_e410 > lohi0_.x) {
+                let _e413 = d_1;
+                local_9 = (_e413 <= lohi0_.y);
             } else {
                 local_9 = false;
             }
-            let _e407 = local_9;
-            if _e407 {
-                let _e408 = d_1;
-                let _e412 = bounds_index((u32(b1_2) - 1u), _e78);
-                let _e415 = bounds[_e412];
-                let _e416 = moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(_e408, _e415);
-                let _e418 = filtered_load(x00_, _e78, 0u);
-                let _e420 = filtered_load(x01_, _e78, 0u);
-                let m0_ = mix(_e418, _e420, fx0_);
-                let _e423 = filtered_load(x00_, _e78, 1u);
-                let _e425 = filtered_load(x01_, _e78, 1u);
-                let m1_ = mix(_e423, _e425, fx0_);
-                let _e428 = lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(m0_, m1_.xy, _e416);
-                vis0_ = _e428;
+            let _e419 = local_9;
+            if _e419 {
+                let _e427 = bounds_index((((u32(b1_2) * LOOKUP) / STRIDE) - 1u), _e78);
+                let range0_ = bounds[_e427];
+                let _e431 = d_1;
+                let _e432 = moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(_e431, range0_);
+                let _e434 = filtered_load(x00_, _e78, 0u);
+                let _e436 = filtered_load(x01_, _e78, 0u);
+                let m0_ = mix(_e434, _e436, fx0_);
+                let _e439 = filtered_load(x00_, _e78, 1u);
+                let _e441 = filtered_load(x01_, _e78, 1u);
+                let m1_ = mix(_e439, _e441, fx0_);
+                let _e444 = lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(m0_, m1_.xy, _e432);
+                vis0_ = _e444;
             }
-            let _e429 = d_1;
-            if (_e429 > lohi1_.x) {
-                let _e432 = d_1;
-                local_10 = (_e432 <= lohi1_.y);
+            let _e445 = d_1;
+            if (_e445 > lohi1_.x) {
+                let _e448 = d_1;
+                local_10 = (_e448 <= lohi1_.y);
             } else {
                 local_10 = false;
             }
-            let _e438 = local_10;
-            if _e438 {
-                let _e439 = d_1;
-                let _e443 = bounds_index((u32(b1_2) - 1u), row1_);
-                let _e446 = bounds[_e443];
-                let _e447 = moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(_e439, _e446);
-                let _e449 = filtered_load(x10_, row1_, 0u);
-                let _e451 = filtered_load(x11_, row1_, 0u);
-                let m0_1 = mix(_e449, _e451, fx1_);
-                let _e454 = filtered_load(x10_, row1_, 1u);
-                let _e456 = filtered_load(x11_, row1_, 1u);
-                let m1_1 = mix(_e454, _e456, fx1_);
-                let _e459 = lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(m0_1, m1_1.xy, _e447);
-                vis1_ = _e459;
+            let _e454 = local_10;
+            if _e454 {
+                let _e462 = bounds_index((((u32(b1_2) * LOOKUP) / STRIDE) - 1u), row1_);
+                let range1_ = bounds[_e462];
+                let _e466 = d_1;
+                let _e467 = moment_zX_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(_e466, range1_);
+                let _e469 = filtered_load(x10_, row1_, 0u);
+                let _e471 = filtered_load(x11_, row1_, 0u);
+                let m0_1 = mix(_e469, _e471, fx1_);
+                let _e474 = filtered_load(x10_, row1_, 1u);
+                let _e476 = filtered_load(x11_, row1_, 1u);
+                let m1_1 = mix(_e474, _e476, fx1_);
+                let _e479 = lit_moments6X_naga_oil_mod_XONRWC5DUMVZDUOTNN5WWK3TUOMX(m0_1, m1_1.xy, _e467);
+                vis1_ = _e479;
             }
-            let _e460 = vis0_;
-            let _e461 = d_1;
-            let _e466 = d_1;
-            vis0_ = select(select(_e460, 0f, (_e461 > lohi0_.y)), 1f, (_e466 <= lohi0_.x));
-            let _e471 = vis1_;
-            let _e472 = d_1;
-            let _e477 = d_1;
-            vis1_ = select(select(_e471, 0f, (_e472 > lohi1_.y)), 1f, (_e477 <= lohi1_.x));
-            let _e482 = vis0_;
-            let _e487 = prev0_;
-            vis0_ = select(clamp(_e482, 0f, 1f), _e487, before0_);
-            let _e489 = vis1_;
-            let _e494 = prev1_;
-            vis1_ = select(clamp(_e489, 0f, 1f), _e494, before1_);
-            let _e496 = vis0_;
-            prev0_ = _e496;
-            let _e497 = vis1_;
-            prev1_ = _e497;
-            let _e499 = done0_;
-            if !(_e499) {
-                let _e502 = total0_;
-                let _e503 = weight0_;
-                let _e504 = vis0_;
-                total0_ = (_e502 + (_e503 * _e504));
+            let _e480 = vis0_;
+            let _e481 = d_1;
+            let _e486 = d_1;
+            vis0_ = select(select(_e480, 0f, (_e481 > lohi0_.y)), 1f, (_e486 <= lohi0_.x));
+            let _e491 = vis1_;
+            let _e492 = d_1;
+            let _e497 = d_1;
+            vis1_ = select(select(_e491, 0f, (_e492 > lohi1_.y)), 1f, (_e497 <= lohi1_.x));
+            let _e502 = vis0_;
+            let _e507 = prev0_;
+            vis0_ = select(clamp(_e502, 0f, 1f), _e507, before0_);
+            let _e509 = vis1_;
+            let _e514 = prev1_;
+            vis1_ = select(clamp(_e509, 0f, 1f), _e514, before1_);
+            let _e516 = vis0_;
+            prev0_ = _e516;
+            let _e517 = vis1_;
+            prev1_ = _e517;
+            let _e519 = done0_;
+            if !(_e519) {
+                let _e522 = total0_;
+                let _e523 = weight0_;
+                let _e524 = vis0_;
+                total0_ = (_e522 + (_e523 * _e524));
             }
-            let _e508 = done1_;
-            if !(_e508) {
-                let _e511 = total1_;
-                let _e512 = weight1_;
-                let _e513 = vis1_;
-                total1_ = (_e511 + (_e512 * _e513));
+            let _e528 = done1_;
+            if !(_e528) {
+                let _e531 = total1_;
+                let _e532 = weight1_;
+                let _e533 = vis1_;
+                total1_ = (_e531 + (_e532 * _e533));
             }
-            let _e516 = done0_;
-            if !(_e516) {
+            let _e536 = done0_;
+            if !(_e536) {
                 local_11 = is_last0_;
             } else {
                 local_11 = true;
             }
-            let _e521 = local_11;
-            done0_ = _e521;
-            let _e522 = done1_;
-            if !(_e522) {
+            let _e541 = local_11;
+            done0_ = _e541;
+            let _e542 = done1_;
+            if !(_e542) {
                 local_12 = is_last1_;
             } else {
                 local_12 = true;
             }
-            let _e527 = local_12;
-            done1_ = _e527;
-            let _e528 = done0_;
-            if _e528 {
-                let _e529 = done1_;
-                local_13 = _e529;
+            let _e547 = local_12;
+            done1_ = _e547;
+            let _e548 = done0_;
+            if _e548 {
+                let _e549 = done1_;
+                local_13 = _e549;
             } else {
                 local_13 = false;
             }
-            let _e533 = local_13;
-            if _e533 {
+            let _e553 = local_13;
+            if _e553 {
                 break;
             }
         }
         continuing {
-            let _e535 = r_1;
-            r_1 = (_e535 + 1u);
+            let _e555 = r_1;
+            r_1 = (_e555 + 1u);
         }
     }
-    let _e539 = total0_;
-    let _e541 = total1_;
-    let l_2 = (((1f - w1_) * _e539) + (w1_ * _e541));
+    let _e559 = total0_;
+    let _e561 = total1_;
+    let l_2 = (((1f - w1_) * _e559) + (w1_ * _e561));
     let c_1 = (color * l_2);
     return c_1;
 }

@@ -145,6 +145,7 @@ pub fn run_prefiltered(
             shadow_map: &sm,
             filtered: &filtered,
             bounds: &bounds,
+            rectified: Some(&rectified),
             cookie: cookie.as_ref(),
         },
     );

@@ -150,6 +150,10 @@ pub fn prefilter_main(
             hi = hi.max(d);
             if store {
                 bounds.store(x, row, 0, [lo, hi, 0.0, 0.0], Storage::Rgba32float);
+                if variant.resume {
+                    // The region's weight sum up to the texel, from which scatter resumes.
+                    bounds.store(x, row, 1, [wsum, 0.0, 0.0, 0.0], Storage::Rgba32float);
+                }
             }
         }
         let blend = select(0.0, w / wsum, wsum > 0.0);
@@ -237,7 +241,8 @@ pub fn prefilter_main(
 pub struct PrefilterOutput {
     /// The filtered bases.
     pub filtered: TexArray,
-    /// Per texel `[min, max, 0, 0]` of the region's depths up to the texel (one layer).
+    /// Per texel `[min, max, 0, 0]` of the region's depths up to the texel (layer 0); with
+    /// `resume` `[W, 0, 0, 0]`, the region's weight sum up to the texel (layer 1).
     pub bounds: TexArray,
 }
 
@@ -255,7 +260,8 @@ pub fn prefilter(
     // The stored columns: Wr / filtered_stride.
     let (w, h) = (variant.filtered_width(frame.sizes[2]), frame.sizes[3]);
     let mut filtered = TexArray::new(w, h, variant.filtered_layers());
-    let mut bounds = TexArray::new(w, h, 1);
+    // (min, max), and with `resume` the weight sums in a second layer.
+    let mut bounds = TexArray::new(w, h, if variant.resume { 2 } else { 1 });
     for row in 0..h {
         for region in 0..variant.regions {
             for thread in 0..variant.threads_per_row_region() {

@@ -22,20 +22,20 @@
 use super::common_cookie::{epipole_march_cookie, spot_segment_cookie};
 use super::common_epipolar::{
     epipole_march, in_epipole_disc, normalised_depth, pixel_dir, ray_column, ray_row_coord, ray_t,
-    row_index, spot_segment,
+    row_index, row_phi, slice_e, spot_segment,
 };
 use super::common_model::{PI, clamp, max, max_u, min, phase_hg, transmittance_between};
-use super::common_moments::{lit_moments4, lit_moments6, moment_z};
-use super::common_prefiltered::{coeff4, fourier_step, region_start, turn};
-use super::common_prefiltered_projective::proj_column;
-use super::common_projective::{proj_boundary, proj_ray_depth, proj_reach};
+use super::common_moments::{lit_moments4, lit_moments6, moment_layer, moment_z};
+use super::common_prefiltered::{coeff4, fourier_step, freq, region_start, texel_weight, turn};
+use super::common_prefiltered_projective::{proj_column, proj_texel_weight};
+use super::common_projective::{proj_boundary, proj_ray_depth, proj_reach, proj_stored_depth};
 use super::common_sampling::{
     EpipolarCamera, EpipolarSamples, SampledOutput, epipolar_samples, run_sampled,
 };
 use super::texture::{Tex, TexArray, mix4, xyz};
 use glam::Vec3;
 use scatter_shaderlib::prefiltered::{
-    Basis, FrameUniforms, LightKind, PrefilteredVariant, Rectification, SliceParams,
+    Basis, FrameUniforms, LightKind, PrefilteredVariant, Rectification, SliceParams, VisibilityMode,
 };
 
 /// The bindings of `scatter`.
@@ -50,8 +50,12 @@ pub struct ScatterInputs<'a> {
     pub shadow_map: &'a Tex,
     /// Filtered bases (from `prefilter`).
     pub filtered: &'a TexArray,
-    /// Region-prefix depth bounds `[min, max, 0, 0]` (from `prefilter`, one layer).
+    /// Region-prefix depth bounds `[min, max, 0, 0]` (from `prefilter`, layer 0; with
+    /// `resume` the weight sums `[W, 0, 0, 0]` in layer 1).
     pub bounds: &'a TexArray,
+    /// The rectified map `prefilter` filtered (`rectify`'s, or a projective frame's
+    /// rasterised one): read with `resume` only.
+    pub rectified: Option<&'a Tex>,
     /// The spot's cookie, for a `cookie` variant (`None`: a white cookie).
     pub cookie: Option<&'a TexArray>,
 }
@@ -91,9 +95,11 @@ pub fn scatter_main(
     // Rectified coordinates of the surface point.
     let axis = xyz(f.axis);
     let rows = f.sizes[3];
-    // The stored columns (Wr / filtered_stride), which the lookups below count in.
+    // The lookups' columns (Wr / lookup: the stored ones, or with `resume` the rectified
+    // ones), which the lookups below count in.
     let stride = variant.filtered_stride;
-    let width = f.sizes[2] / stride;
+    let lookup = if variant.resume { 1 } else { stride };
+    let width = f.sizes[2] / lookup;
     let regions = variant.regions;
     let wrap = f.anti_epipole[3] > 0.5;
     let yc: f32;
@@ -124,7 +130,7 @@ pub fn scatter_main(
         if spot {
             g = (f.axis[3] - s * q.z) / qs;
         }
-        xs = proj_column(f, g, regions, width, spot);
+        xs = (stride / lookup) as f32 * proj_column(f, g, regions, f.sizes[2] / stride, spot);
     } else {
         // The view angle from the light axis as atan2(|dir x axis|, dir . axis): acos of the
         // dot product resolves angles near the axis only to sqrt(2 * 6e-8) = 3.5e-4 in f32.
@@ -175,9 +181,9 @@ pub fn scatter_main(
     let (mut delta0, mut delta1) = (1.0, 1.0);
     let (mut xs0, mut xs1) = (xs, xs);
     if !proj {
-        // A stored column spans `stride` rectified columns.
-        delta0 = stride as f32 * inp.slices[row0 as usize].delta;
-        delta1 = stride as f32 * inp.slices[row1 as usize].delta;
+        // A lookup column spans `lookup` rectified columns.
+        delta0 = lookup as f32 * inp.slices[row0 as usize].delta;
+        delta1 = lookup as f32 * inp.slices[row1 as usize].delta;
         xs0 = reach / delta0;
         xs1 = reach / delta1;
     }
@@ -187,15 +193,16 @@ pub fn scatter_main(
     let (mut done0, mut done1) = (false, false);
     // The furthest stored edge a row's bounds lookup may read in the ray's last region: the
     // last one at most one rectified column past the ray's end (see the WGSL).
-    let kf = stride as f32;
+    let kf = lookup as f32;
     let cap0 = (((xs0 * kf).floor() + 1.0) / kf).floor();
     let cap1 = (((xs1 * kf).floor() + 1.0) / kf).floor();
     // The previous region's lit fraction per row, for a last region whose first stored edge
     // lies past `cap`.
     let (mut prev0, mut prev1) = (Vec3::ZERO, Vec3::ZERO);
     for r in 0..regions {
-        let b0 = region_start(r, regions, width, spot) as f32;
-        let b1 = region_start(r + 1, regions, width, spot) as f32;
+        // The region's first and next region's first lookup column (on stored columns).
+        let b0 = (stride / lookup * region_start(r, regions, f.sizes[2] / stride, spot)) as f32;
+        let b1 = (stride / lookup * region_start(r + 1, regions, f.sizes[2] / stride, spot)) as f32;
         let is_last0 = last0 < b1 as u32 || r + 1 == regions;
         let is_last1 = last1 < b1 as u32 || r + 1 == regions;
         let pos_of = |xs: f32, is_last: bool| {
@@ -279,13 +286,32 @@ pub fn scatter_main(
         let (x10, x11, fx1) = texels(pos1);
         // Their depth bounds: a region's prefix bounds only widen along the row, so column
         // x1's cover column x0's; x1 of the lookup stopped at `cap`.
-        let lohi0 = inp.bounds.load(texels(bpos0).1, row0, 0);
-        let lohi1 = inp.bounds.load(texels(bpos1).1, row1, 0);
+        let resume = Resume {
+            inp,
+            variant,
+            start: b0 as u32,
+            region: r,
+            proj,
+        };
+        let (from0, from1) = (resume.origin(x00), resume.origin(x10));
+        let (lohi0, lohi1) = if variant.resume {
+            // Resumed from each row's last stored column before x0 + 1 in the region (at a
+            // lookup of one rectified column the bounds' column is x1).
+            (
+                resume.bounds(from0, x01, row0),
+                resume.bounds(from1, x11, row1),
+            )
+        } else {
+            (
+                inp.bounds.load(texels(bpos0).1, row0, 0),
+                inp.bounds.load(texels(bpos1).1, row1, 0),
+            )
+        };
         let ambiguous = |lohi: [f32; 4]| d > lohi[0] && d <= lohi[1];
         // The ray's depth in a row's moment coordinate: the region's whole depth range is its
         // bounds at its last stored column (`moment_z`).
         let zf_of = |row: u32| {
-            let range = inp.bounds.load(b1 as u32 - 1, row, 0);
+            let range = inp.bounds.load(b1 as u32 * lookup / stride - 1, row, 0);
             moment_z(d, [range[0], range[1]])
         };
         let (add0, add1) = if tinted {
@@ -306,26 +332,51 @@ pub fn scatter_main(
             let (mut vis0, mut vis1) = (0.5, 0.5);
             if moments {
                 // The region's moments, filtered linearly along each row.
-                let lit = |x0: u32, x1: u32, fx: f32, row: u32| {
-                    let zf = zf_of(row);
-                    let fetch = |layer: u32| {
-                        let load = |x: u32| inp.filtered.load(x, row, layer);
-                        mix4(load(x0), load(x1), fx)
+                let lit = |x0: u32, x1: u32, fx: f32, row: u32, origin: [u32; 2]| {
+                    let range = inp.bounds.load(b1 as u32 * lookup / stride - 1, row, 0);
+                    let zf = moment_z(d, [range[0], range[1]]);
+                    let [m0, m1] = if variant.resume {
+                        resume.moments(origin, x0, x1, fx, [range[0], range[1]], row)
+                    } else {
+                        let fetch = |layer: u32| {
+                            let load = |x: u32| inp.filtered.load(x, row, layer);
+                            mix4(load(x0), load(x1), fx)
+                        };
+                        [
+                            fetch(0),
+                            if variant.moments == 6 {
+                                fetch(1)
+                            } else {
+                                [0.0; 4]
+                            },
+                        ]
                     };
-                    let m0 = fetch(0);
                     if variant.moments == 6 {
-                        let m1 = fetch(1);
                         lit_moments6(m0, [m1[0], m1[1]], zf)
                     } else {
                         lit_moments4(m0, zf)
                     }
                 };
                 if ambiguous(lohi0) {
-                    vis0 = lit(x00, x01, fx0, row0);
+                    vis0 = lit(x00, x01, fx0, row0, from0);
                 }
                 if ambiguous(lohi1) {
-                    vis1 = lit(x10, x11, fx1, row1);
+                    vis1 = lit(x10, x11, fx1, row1, from1);
                 }
+            } else if variant.resume && (ambiguous(lohi0) || ambiguous(lohi1)) {
+                // a(d) . F at each row's stored column, then resumed up to x0 and x1.
+                let (mut dot0, mut dot1) = (0.0, 0.0);
+                for layer in 0..variant.layers() {
+                    let coeff = coeffs[layer as usize];
+                    let texel0 = inp.filtered.load(from0[0], row0, layer);
+                    let texel1 = inp.filtered.load(from1[0], row1, layer);
+                    for k in 0..4 {
+                        dot0 += coeff[k] * (texel0[k] * 2.0 - 1.0);
+                        dot1 += coeff[k] * (texel1[k] * 2.0 - 1.0);
+                    }
+                }
+                vis0 += resume.fourier(from0, x00, x01, fx0, d, dot0, row0);
+                vis1 += resume.fourier(from1, x10, x11, fx1, d, dot1, row1);
             } else if ambiguous(lohi0) || ambiguous(lohi1) {
                 for layer in 0..variant.layers() {
                     let coeff = coeffs[layer as usize];
@@ -450,6 +501,180 @@ fn tinted_region(
         Vec3::new(f(v.x, c.x), f(v.y, c.y), f(v.z, c.z))
     };
     (fraction(0), fraction(1))
+}
+
+/// `resume` (`templates/include/scatter_resume.wgsl`): a region's lookups resumed from the
+/// last stored column before them over the rectified texels up to them, as `prefilter`
+/// filtered them: `F(x) = (W_c F_c + sum_i w_i B(d_i)) / (W_c + sum_i w_i)`.
+struct Resume<'a> {
+    inp: &'a ScatterInputs<'a>,
+    variant: &'a PrefilteredVariant,
+    /// The region's first rectified column.
+    start: u32,
+    region: u32,
+    /// A projective frame.
+    proj: bool,
+}
+
+impl Resume<'_> {
+    /// Rectified texel `(i, row)`'s depth as `prefilter` filtered it (`resume_depth`).
+    fn depth(&self, i: u32, row: u32) -> f32 {
+        let rectified = self
+            .inp
+            .rectified
+            .expect("a resume variant's scatter inputs carry the rectified map");
+        let d = rectified.load(i, row);
+        if self.proj { proj_stored_depth(d) } else { d }
+    }
+
+    /// `prefilter`'s weight of rectified texel `i` of `row` (`resume_weight`, `resume_e`).
+    fn weight(&self, i: u32, row: u32) -> f32 {
+        let f = self.inp.frame;
+        let sp = &self.inp.slices[row as usize];
+        let weighted = self.variant.visibility == VisibilityMode::Weighted;
+        let spot = self.variant.light == LightKind::Spot;
+        if self.proj {
+            return proj_texel_weight(
+                f,
+                sp,
+                i,
+                self.region,
+                self.variant.regions,
+                self.variant.filtered_stride,
+                weighted,
+                spot,
+            );
+        }
+        let e = if spot {
+            slice_e(f, row_phi(f, row))
+        } else {
+            Vec3::ZERO
+        };
+        texel_weight(f, sp, e, i, weighted, spot)
+    }
+
+    /// `resume_from`: (the last stored column whose right edge lies at or before `x0`, the
+    /// first texel after it), or `(0, start)` where the region has none there.
+    fn origin(&self, x0: u32) -> [u32; 2] {
+        let k = self.variant.filtered_stride;
+        let c = (x0 + 1) / k * k;
+        if c > self.start {
+            [c / k - 1, c]
+        } else {
+            [0, self.start]
+        }
+    }
+
+    /// `resume_bounds`: the region's (min, max) depth of `row` up to column `x1`.
+    fn bounds(&self, origin: [u32; 2], x1: u32, row: u32) -> [f32; 4] {
+        let mut lohi = [1e30f32, -1e30f32];
+        if origin[1] > self.start {
+            let b = self.inp.bounds.load(origin[0], row, 0);
+            lohi = [b[0], b[1]];
+        }
+        for i in origin[1]..=x1 {
+            let di = self.depth(i, row);
+            lohi = [lohi[0].min(di), lohi[1].max(di)];
+        }
+        [lohi[0], lohi[1], 0.0, 0.0]
+    }
+
+    /// `resume_w`: the stored weight sum at `origin`, 0 at the region's first column.
+    fn stored_w(&self, origin: [u32; 2], row: u32) -> f32 {
+        if origin[1] > self.start {
+            self.inp.bounds.load(origin[0], row, 1)[0]
+        } else {
+            0.0
+        }
+    }
+
+    /// `resume_fourier`: `a(d) . F` of `row` blended between columns `x0` and `x1` by `fx`;
+    /// `at_origin` is `a(d) . F` at the stored column.
+    #[allow(clippy::too_many_arguments, reason = "mirrors the WGSL signature")]
+    fn fourier(
+        &self,
+        origin: [u32; 2],
+        x0: u32,
+        x1: u32,
+        fx: f32,
+        d: f32,
+        at_origin: f32,
+        row: u32,
+    ) -> f32 {
+        let frequencies = 2 * self.variant.layers();
+        let mut w = self.stored_w(origin, row);
+        let mut sum = w * at_origin;
+        let (mut w0, mut sum0) = (w, sum);
+        for i in origin[1]..=x1 {
+            let wi = self.weight(i, row);
+            w += wi;
+            sum += wi * step_series(self.depth(i, row) - d, frequencies);
+            if i == x0 {
+                (w0, sum0) = (w, sum);
+            }
+        }
+        let mean = |s: f32, w: f32| if w > 0.0 { s / w } else { 0.0 };
+        let (a, b) = (mean(sum0, w0), mean(sum, w));
+        a * (1.0 - fx) + b * fx
+    }
+
+    /// `resume_moments`: the moments of `row` (layer 0, and layer 1 with 6 moments) blended
+    /// between columns `x0` and `x1` by `fx`, the depths in `range`'s coordinate.
+    #[allow(clippy::too_many_arguments, reason = "mirrors the WGSL signature")]
+    fn moments(
+        &self,
+        origin: [u32; 2],
+        x0: u32,
+        x1: u32,
+        fx: f32,
+        range: [f32; 2],
+        row: u32,
+    ) -> [[f32; 4]; 2] {
+        let six = self.variant.moments == 6;
+        let w_origin = self.stored_w(origin, row);
+        let mut w = w_origin;
+        let scale = |v: [f32; 4], k: f32| v.map(|c| c * k);
+        let add = |a: [f32; 4], b: [f32; 4]| [a[0] + b[0], a[1] + b[1], a[2] + b[2], a[3] + b[3]];
+        let mut sa = scale(self.inp.filtered.load(origin[0], row, 0), w_origin);
+        let mut sb = if six {
+            scale(self.inp.filtered.load(origin[0], row, 1), w_origin)
+        } else {
+            [0.0; 4]
+        };
+        let (mut w0, mut sa0, mut sb0) = (w, sa, sb);
+        for i in origin[1]..=x1 {
+            let wi = self.weight(i, row);
+            let z = moment_z(self.depth(i, row), range);
+            w += wi;
+            sa = add(sa, scale(moment_layer(z, 0), wi));
+            if six {
+                sb = add(sb, scale(moment_layer(z, 1), wi));
+            }
+            if i == x0 {
+                (w0, sa0, sb0) = (w, sa, sb);
+            }
+        }
+        let k0 = if w0 > 0.0 { 1.0 / w0 } else { 0.0 };
+        let k1 = if w > 0.0 { 1.0 / w } else { 0.0 };
+        [
+            mix4(scale(sa0, k0), scale(sa, k1), fx),
+            mix4(scale(sb0, k0), scale(sb, k1), fx),
+        ]
+    }
+}
+
+/// `step_series`: `a(d) . B(d_i)` as a function of `x = d_i - d`, the sum over the
+/// `frequencies` Fourier frequencies `c_k` of `2 / c_k sin(c_k x)`, by the turns of
+/// `fourier_step` from `(sin, cos)(pi x)`.
+fn step_series(x: f32, frequencies: u32) -> f32 {
+    let mut a = [(PI * x).sin(), (PI * x).cos()];
+    let step = fourier_step(a);
+    let mut sum = 0.0;
+    for k in 1..=frequencies {
+        sum += 2.0 / freq(k) * a[0];
+        a = turn(a, step);
+    }
+    sum
 }
 
 /// Runs every pixel (rows in parallel), or the samples and the upsample of a sampled

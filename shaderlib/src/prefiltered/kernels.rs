@@ -108,6 +108,7 @@ struct PrefilterTemplate {
     cbar_layer: u32,
     acc_layers: u32,
     stride: u32,
+    resume: bool,
 }
 
 /// The askama views of `scatter.wgsl` and of the two epipolar passes that render it with
@@ -135,6 +136,8 @@ macro_rules! scatter_templates {
             filtered_layers: u32,
             cbar_layer: u32,
             stride: u32,
+            resume: bool,
+            weighted: bool,
             sampling: SamplingView,
         }
 
@@ -158,6 +161,8 @@ macro_rules! scatter_templates {
                     filtered_layers: variant.filtered_layers(),
                     cbar_layer: 3 * variant.layers(),
                     stride: variant.filtered_stride,
+                    resume: variant.resume,
+                    weighted: variant.visibility == VisibilityMode::Weighted,
                     sampling: scatter_sampling_view(variant, kernel),
                 }
             }
@@ -245,6 +250,7 @@ pub(crate) fn render_prefilter(variant: &PrefilteredVariant) -> Result<String, S
         cbar_layer: 3 * variant.layers(),
         acc_layers: 3 * variant.per_thread().div_ceil(4),
         stride: variant.filtered_stride,
+        resume: variant.resume,
     }
     .render()
     .map_err(render_error(Kernel::Prefilter))

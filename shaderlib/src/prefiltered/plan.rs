@@ -27,9 +27,19 @@ pub const PROJECTIVE_WITHOUT_SHADOW_MAP: &str = "the frame is projective and the
 /// Elements of the region-prefix depth bounds written by `prefilter`: one `vec2<f32>` (min,
 /// max) per stored column and rectified row ([`stored_width`]), 32-bit so that the bound
 /// tests compare the very depths the filter saw.
+/// With `resume` a second plane of as many follows: per stored texel `(W, 0)`, the region's
+/// weight sum up to the texel, from which `scatter` resumes the running means.
 pub fn bounds_elements(v: &PrefilteredVariant) -> Formula {
-    format!("{} * rectified.height", stored_width(v))
+    if v.resume {
+        format!("2 * {} * rectified.height", stored_width(v))
+    } else {
+        format!("{} * rectified.height", stored_width(v))
+    }
 }
+
+/// The binding at which `scatter` (and its sampled passes) reads the rectified map with
+/// `resume` (the depths of the texels after a stored column).
+pub const RESUME_RECTIFIED_BINDING: u32 = 10;
 
 /// The columns `prefilter` stores per row: `rectified.width`, or with coarse filtered
 /// columns (`filtered_stride = k > 1`) `ceil(rectified.width / k)` (the width is a multiple
@@ -190,6 +200,15 @@ pub fn plan(v: &PrefilteredVariant) -> Plan {
              columns and rectified.width reads rectified.width / k; the rectified width must \
              be a multiple of k, and in a projective \
              frame the region viewports (FrameReport::projective) start on multiples of k.",
+        );
+    }
+    if v.resume {
+        notes.push(
+            "resume: bounds holds two planes of stored_width x rectified.height vec2<f32>: \
+             (min, max) as without it, then (W, 0), the region's weight sum up to the texel, \
+             at element stored_width * rectified.height + x * rectified.height + row; \
+             scatter and its sampled passes also read the rectified map (binding 10) to \
+             resume the running means from the stored column before a ray's end.",
         );
     }
     if v.rectification == Rectification::Projective {
@@ -359,6 +378,14 @@ pub fn pass(v: &PrefilteredVariant, kernel: Kernel) -> Option<PassPlan> {
                     bind(6, "bounds"),
                 ]
                 .into_iter()
+                .chain(v.resume.then_some(BindingSource {
+                    binding: RESUME_RECTIFIED_BINDING,
+                    resource: "rectified",
+                    alternative: projective.then_some(Alternative {
+                        resource: RECTIFIED_RASTER,
+                        when: PROJECTIVE_FRAME,
+                    }),
+                }))
                 .chain(v.cookie.then(|| bind(COOKIE_BINDING, "cookie")))
                 .collect(),
             },

@@ -31,6 +31,15 @@ fn bounds_index(x: u32, row: u32) -> u32 {
     return x * frame.sizes[3] + row;
 }
 
+{%- if resume %}
+
+// The index in `bounds` of stored texel (x, row)'s weight sum (resume): the second plane,
+// after the Wc x Hr (min, max) pairs.
+fn weight_index(x: u32, row: u32) -> u32 {
+    return (frame.sizes[2] / STRIDE) * frame.sizes[3] + bounds_index(x, row);
+}
+{%- endif %}
+
 // The index in `filtered` of layer `layer` of stored texel (x, row).
 fn filtered_index(x: u32, row: u32, layer: u32) -> u32 {
 {%- if storage == "rgba32float" %}
