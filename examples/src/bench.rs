@@ -991,6 +991,23 @@ fn sampled_variants() -> Vec<(Method, Method)> {
     );
     out.push((Method::from(stride4), stride4_sampled));
     out.push((Method::prefiltered_default(), stride4_sampled));
+    // `resume` at filtered_stride 8: the prefiltered default sampled with
+    // [`SLICE_ROWS_RECTIFIED`], `prefilter` storing every eighth column and the samples and
+    // fallback pixels resuming the running means between them: the default's answer (up to
+    // its rgba8 rounding), so compared with the default per pixel; and with itself per pixel,
+    // which is slower than the default (every pixel resumes; docs/roofline.md, "Stop 58").
+    let resume8: FamilyVariant = PrefilteredVariant {
+        filtered_stride: 8,
+        resume: true,
+        ..PrefilteredVariant::default()
+    }
+    .into();
+    let resume8_sampled = Method::new(
+        resume8.with_sampling(SamplingKnobs::epipolar(HEADLINE_SLICES)),
+        Some(SLICE_ROWS_RECTIFIED),
+    );
+    out.push((Method::prefiltered_default(), resume8_sampled));
+    out.push((Method::from(resume8), resume8_sampled));
     for slices in [SamplingKnobs::DEFAULT_SLICES, HEADLINE_SLICES] {
         out.push((
             Method::from(n256),
@@ -1103,6 +1120,13 @@ fn headline_runs(ctx: &Context, config: &BenchConfig) -> Result<Vec<HeadlineRow>
             ..PrefilteredVariant::default()
         }));
     }
+    // `resume` at stride 8 per pixel: the per-pixel frame of the sampled `resume` row, which
+    // every pixel pays the resumption in (docs/roofline.md, "Stop 58").
+    methods.push(Method::from(PrefilteredVariant {
+        filtered_stride: 8,
+        resume: true,
+        ..PrefilteredVariant::default()
+    }));
     for bases in [32, 96, 128] {
         methods.push(Method::from(
             FamilyVariant::from(PrefilteredVariant {

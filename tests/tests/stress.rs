@@ -127,7 +127,7 @@ const DARK_EXCEPTIONS: &[(&str, Rectification, f64, &str)] = &[];
 /// The variants run on every case (directional; each case sets the light, and the
 /// prefiltered Fourier bases where it stresses them): the prefiltered default, epipolar and
 /// projective, and with average visibility; the moment basis with 4 moments (3 regions) and
-/// 6 (8 and 16 regions); raymarch N = 16, 64 and 256; minmax.
+/// 6 (8 and 16 regions); raymarch N = 16, 64 and 256; minmax; then the sampled ones.
 fn methods() -> Vec<FamilyVariant> {
     let raymarch = |samples| {
         FamilyVariant::Raymarch(RaymarchVariant {
@@ -174,6 +174,14 @@ fn methods() -> Vec<FamilyVariant> {
         FamilyVariant::from(MinmaxVariant::default()).with_sampling(SamplingKnobs::lowres(4)),
         // And epipolar at its defaults.
         FamilyVariant::from(PrefilteredVariant::default()).with_sampling(epipolar()),
+        // The prefiltered default storing every eighth column and resuming between them
+        // (`resume`: the bench's sampled prefiltered frame, docs/roofline.md "Stop 58").
+        FamilyVariant::from(PrefilteredVariant {
+            filtered_stride: 8,
+            resume: true,
+            ..PrefilteredVariant::default()
+        })
+        .with_sampling(epipolar()),
         raymarch(64).with_sampling(epipolar()),
         FamilyVariant::from(MinmaxVariant::default()).with_sampling(epipolar()),
         // Issue 15: partial-sum trees (epipolar samples only, every sample answered).

@@ -761,8 +761,8 @@ pub fn layout_of(samples: &TexArray, slices: u32) -> EpipolarLayout {
 /// What the epipolar unwarp (`<kernel>_unwarp`) produced.
 #[derive(Clone, Debug)]
 pub struct EpipolarUnwarp {
-    /// The screen-sized output as stored (rgba16float); the listed pixels are left 0 (the
-    /// GPU pass does not write them).
+    /// The screen-sized output as stored (rgba16float); the listed pixels hold 0 (the GPU
+    /// pass stores `lowres_blend`'s alpha-0 texel there, which the fallback overwrites).
     pub output: TexArray,
     /// The pixels no sample stands for (`fallback_pixels`), in row-major order (the GPU
     /// lists them in no particular order).

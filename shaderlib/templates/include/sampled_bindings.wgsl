@@ -72,22 +72,37 @@ fn fallback_list_reset() {
 
 // The unwarp's end for pixel `q` (both sampled modes): the blend of its taps (`w` their
 // weights, `support` the weights that decide which stand around it, `depths` their pixels'
-// depths, `light` their radiance) kept by depth and light spread (`lowres_blend`) into
-// `output`, or `q` listed in `fallback_pixels` where they cannot stand for it (nothing
-// written).
-fn unwarp_pixel(q: vec2<u32>, w: vec4<f32>, support: vec4<f32>, depths: vec4<f32>, light: array<vec3<f32>, 4>) {
+// depths, `light` their radiance) kept by depth and light spread (`lowres_blend`) stored into
+// `output`; where they cannot stand for it the texel stored is 0 (alpha 0, which the
+// fallback pass overwrites) and the pixel's bit is returned (1u << i, `i` its place in the
+// block) for `fallback_list_block`.
+fn unwarp_pixel(q: vec2<u32>, i: u32, w: vec4<f32>, support: vec4<f32>, depths: vec4<f32>, light: array<vec3<f32>, 4>) -> u32 {
     let c = lowres_blend(w, support, depths, light, textureLoad(depth, q, 0).x, DEPTH_BREAK, LIGHT_BREAK);
-    if c.w == 0.0 {
-        let e = atomicAdd(&fallback_count.listed, 1u);
-        fallback_pixels[e] = q.x | (q.y << 16u);
-        if e % 64u == 0u {
-            // The first entry of workgroup e / 64 of the fallback's dispatch: cover it.
-            let g = e / 64u + 1u;
-            atomicMax(&fallback_count.groups_x, min(g, FALLBACK_ROW_GROUPS));
-            atomicMax(&fallback_count.groups_y, (g + FALLBACK_ROW_GROUPS - 1u) / FALLBACK_ROW_GROUPS);
+    textureStore(output, q, c);
+    return select(0u, 1u << i, c.w == 0.0);
+}
+
+// Lists the pixels of the block from `q0` (`side` pixels per row) whose bits `listed` holds
+// in `fallback_pixels`, with one atomic for the block, and raises the fallback's workgroup
+// counts to cover them. Once per block, not per pixel: llvmpipe runs an `if` body under a
+// mask whether or not a lane takes it, and a per-pixel list (an atomic and two more where an
+// entry opened a workgroup) cost 1.5-2 ms of the unwarp at 1280x720 (prefiltered, 256 slices;
+// docs/roofline.md, "Stop 58").
+fn fallback_list_block(q0: vec2<u32>, side: u32, listed: u32) {
+    if listed != 0u {
+        let n = countOneBits(listed);
+        let e0 = atomicAdd(&fallback_count.listed, n);
+        var bits = listed;
+        for (var j = 0u; j < n; j++) {
+            let i = firstTrailingBit(bits);
+            bits &= bits - 1u;
+            let q = q0 + vec2<u32>(i % side, i / side);
+            fallback_pixels[e0 + j] = q.x | (q.y << 16u);
         }
-    } else {
-        textureStore(output, q, c);
+        // The workgroups of 64 entries the list now reaches.
+        let g = (e0 + n - 1u) / 64u + 1u;
+        atomicMax(&fallback_count.groups_x, min(g, FALLBACK_ROW_GROUPS));
+        atomicMax(&fallback_count.groups_y, (g + FALLBACK_ROW_GROUPS - 1u) / FALLBACK_ROW_GROUPS);
     }
 }
 {%- endif %}

@@ -31,7 +31,7 @@ fn {{ sampling.entry }}(@builtin(global_invocation_id) id: vec3<u32>) {
 // Sampling pass 2 (`sampling = lowres`, scatter::sampling): invocation `id` gathers the
 // pixels of block `id` (S x S pixels from S id, those on the screen): each the blend of its
 // four samples (`lowres_taps`) kept by depth and light spread (`lowres_blend`), or, where they
-// cannot stand for it, listed in `fallback_pixels` for pass 3 (nothing written). The pixels of
+// cannot stand for it, listed in `fallback_pixels` for pass 3 (0 written), the block's list with one atomic. The pixels of
 // a block share their four samples (only their weights differ), so the block loads them once:
 // 4 sample loads for S^2 pixels instead of 4 per pixel (llvmpipe pays about 1 ms per texel
 // load per 1280x720 pixels; one invocation per pixel took 9-10 ms at 1280x720, stop 45).
@@ -51,13 +51,15 @@ fn {{ sampling.entry }}(@builtin(global_invocation_id) id: vec3<u32>) {
         depths[j] = v.w;
         light[j] = v.xyz;
     }
+    var listed = 0u;
     for (var i = 0u; i < SCALE * SCALE; i++) {
         let q = q0 + vec2<u32>(i % SCALE, i / SCALE);
         if q.x < screen.x && q.y < screen.y {
             let w = lowres_taps(q, screen, SCALE).w;
-            unwarp_pixel(q, w, w, depths, light);
+            listed |= unwarp_pixel(q, i, w, w, depths, light);
         }
     }
+    fallback_list_block(q0, SCALE, listed);
 }
 {%- else if sampling.epipolar && !sampling.unwarp && !sampling.fallback %}
 
@@ -211,7 +213,7 @@ fn {{ sampling.entry }}(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_in
 // clamped to the block's samples), kept by depth and light spread as the centre's weights
 // would keep them (`lowres_blend`'s support: so that a pixel clamped onto one slice or one
 // sample still sees the others for both criteria), or, where they cannot stand for it, is
-// listed in `fallback_pixels` for pass 3 and nothing written (as is a pixel whose own slice
+// listed in `fallback_pixels` for pass 3 (0 written; one atomic per block, `fallback_list_block`) (as is a pixel whose own slice
 // lies more than half a slice beyond the block's: slices closer than a pixel). With B = 2
 // `minmax_traverse_unwarp` took 13.3-15.7 against 19.2-19.6 ms per pixel at 1280x720
 // (llvmpipe pays about 1 ms per texel load and 1 ms per `atan2` over the screen;
@@ -245,13 +247,15 @@ fn {{ sampling.entry }}(@builtin(global_invocation_id) id: vec3<u32>) {
         light[j] = v.xyz;
     }
     let support = epipolar_block_weights(b, vec2<f32>(0.0, 0.0));
+    var listed = 0u;
     for (var i = 0u; i < UNWARP_BLOCK * UNWARP_BLOCK; i++) {
         let q = q0 + vec2<u32>(i % UNWARP_BLOCK, i / UNWARP_BLOCK);
         if q.x < screen.x && q.y < screen.y {
             let w = epipolar_block_weights(b, vec2<f32>(q) + vec2<f32>(0.5, 0.5) - centre);
-            unwarp_pixel(q, w, support, depths, light);
+            listed |= unwarp_pixel(q, i, w, support, depths, light);
         }
     }
+    fallback_list_block(q0, UNWARP_BLOCK, listed);
 }
 {%- else if sampling.fallback %}
 
