@@ -248,7 +248,7 @@ pub struct PrefilteredVariant {
     /// stores, for at most k texels more per lookup. `prefilter` stores each stored column's
     /// weight sum beside its bounds. Meant for sampled frames (`sampling = epipolar |
     /// lowres`), which look up far fewer points than `prefilter` stores; see
-    /// `docs/roofline.md` ("Stop 58").
+    /// `docs/roofline.md` ("Stop 58"). With a cookie the texels' cookies are resumed too.
     #[serde(skip_serializing_if = "std::ops::Not::not")]
     pub resume: bool,
 }
@@ -433,15 +433,6 @@ impl PrefilteredVariant {
                     .into(),
             });
         }
-        if self.resume && self.cookie {
-            return Err(VariantError {
-                knob: "resume",
-                value: "true".into(),
-                allowed: "false with cookie = true (scatter does not resume a cookie's \
-                          per-channel means; use filtered_stride = 1 or a coarse map)"
-                    .into(),
-            });
-        }
         self.sampling_knobs().validate()?;
         crate::cookie::validate_cookie(self.cookie, self.light)
     }
@@ -547,8 +538,9 @@ impl PrefilteredVariant {
 
     /// The `resume` variants of [`Self::grid`]: every `filtered_stride` above 1 with every
     /// light, rectification and visibility, the five bases of [`Self::stride_grid`] and the
-    /// regions that fit [`Self::STRIDE_GRID_WIDTH`] cycling (24 variants: every knob value
-    /// meets every stride; no cookie, which `resume` does not take).
+    /// regions that fit [`Self::STRIDE_GRID_WIDTH`] cycling, then the spot with its cookie
+    /// (Fourier and 4 moments) at each stride (30 variants: every knob value meets every
+    /// stride).
     fn resume_grid(regions: std::ops::RangeInclusive<u32>) -> Vec<PrefilteredVariant> {
         let bases = [
             Self::default(),
@@ -592,6 +584,28 @@ impl PrefilteredVariant {
                         n += 1;
                     }
                 }
+            }
+            // The spot with its cookie: the Fourier basis and 4 moments, one rectification
+            // each, alternating with k; 2 regions (within `regions`), whose starts every
+            // stride keeps on the conformance map, so that the outputs compare with k = 1.
+            for (i, base) in [Self::default(), Self::with_moments(4)]
+                .into_iter()
+                .enumerate()
+            {
+                out.push(PrefilteredVariant {
+                    regions: if fits.contains(&2) {
+                        2
+                    } else {
+                        fits[n % fits.len()]
+                    },
+                    light: LightKind::Spot,
+                    rectification: Rectification::ALL[(i + k as usize / 2) % 2],
+                    cookie: true,
+                    filtered_stride: k,
+                    resume: true,
+                    ..base
+                });
+                n += 1;
             }
         }
         out

@@ -95,7 +95,7 @@
 #import scatter::epipolar::{SliceParams, row_phi, slice_e}
 {%- if projective %}
 #import scatter::projective::proj_stored_depth
-#import scatter::prefiltered_projective::proj_texel_weight
+#import scatter::prefiltered_projective::{proj_texel_weight{% if cookie %}, proj_region_g{% endif %}}
 {%- endif %}
 {%- endif %}
 {%- if projective %}
@@ -103,7 +103,7 @@
 #import scatter::prefiltered_projective::proj_column
 {%- endif %}
 {%- if cookie %}
-#import scatter::cookie::{epipole_march_cookie, spot_segment_cookie}
+#import scatter::cookie::{epipole_march_cookie, spot_segment_cookie{% if resume %}, frame_cookie{% endif %}}
 {%- endif %}
 {%- if !sampling.imports.is_empty() %}
 {{ sampling.imports }}
@@ -376,6 +376,65 @@ fn scatter_pixel(x: u32, y: u32) -> vec3<f32> {
         let lohi1 = bounds[bounds_index(select(xb10, min(xb10 + 1u, width - 1u), bb1 > floor(bb1)), row1)];
 {%- endif %}
 {%- if cookie %}
+{%- if resume %}
+        let amb0 = d > lohi0.x && d <= lohi0.y;
+        let amb1 = d > lohi1.x && d <= lohi1.y;
+{%- if moments %}
+        // The region's whole depth range per row (`moment_z`), the mean cookie and the
+        // channels' moments of the cookie-weighted depths, resumed; the lit share per channel
+        // from the moments over Cbar.
+        let range0 = bounds[bounds_index(u32(b1) * LOOKUP / STRIDE - 1u, row0)];
+        let range1 = bounds[bounds_index(u32(b1) * LOOKUP / STRIDE - 1u, row1)];
+        let zf0 = moment_z(d, range0);
+        let zf1 = moment_z(d, range1);
+        let rc0 = resume_cookie(from0, u32(b0), x00, x01, fx0, range0, amb0, row0, r, proj_frame);
+        let rc1 = resume_cookie(from1, u32(b0), x10, x11, fx1, range1, amb1, row1, r, proj_frame);
+        let cbar0 = rc0.cbar;
+        let cbar1 = rc1.cbar;
+        var vis0 = 0.5 * cbar0;
+        var vis1 = 0.5 * cbar1;
+        for (var c = 0u; c < 3u; c++) {
+            if amb0 && cbar0[c] > 0.0 {
+{%- if moment_count == 6 %}
+                vis0[c] = cbar0[c] * lit_moments6(rc0.a[c] / cbar0[c], (rc0.b[c] / cbar0[c]).xy, zf0);
+{%- else %}
+                vis0[c] = cbar0[c] * lit_moments4(rc0.a[c] / cbar0[c], zf0);
+{%- endif %}
+            }
+            if amb1 && cbar1[c] > 0.0 {
+{%- if moment_count == 6 %}
+                vis1[c] = cbar1[c] * lit_moments6(rc1.a[c] / cbar1[c], (rc1.b[c] / cbar1[c]).xy, zf1);
+{%- else %}
+                vis1[c] = cbar1[c] * lit_moments4(rc1.a[c] / cbar1[c], zf1);
+{%- endif %}
+            }
+        }
+{%- else %}
+        // Per channel a(d) . F^c at each row's stored column (where the row is ambiguous),
+        // then the mean cookie and the channels' series resumed up to x0 and x1.
+        var at0 = vec3<f32>(0.0);
+        var at1 = vec3<f32>(0.0);
+        if amb0 || amb1 {
+            for (var layer = 0u; layer < LAYERS; layer++) {
+                let coeff = coeffs[layer];
+                for (var c = 0u; c < 3u; c++) {
+                    let texel0 = filtered_load(from0.x, row0, c * LAYERS + layer);
+                    let texel1 = filtered_load(from1.x, row1, c * LAYERS + layer);
+                    for (var k = 0u; k < 4u; k++) {
+                        at0[c] += coeff[k] * (texel0[k] * 2.0 - 1.0);
+                        at1[c] += coeff[k] * (texel1[k] * 2.0 - 1.0);
+                    }
+                }
+            }
+        }
+        let rc0 = resume_cookie(from0, u32(b0), x00, x01, fx0, d, at0, amb0, row0, r, proj_frame);
+        let rc1 = resume_cookie(from1, u32(b0), x10, x11, fx1, d, at1, amb1, row1, r, proj_frame);
+        let cbar0 = rc0.cbar;
+        let cbar1 = rc1.cbar;
+        var vis0 = 0.5 * cbar0 + rc0.vis;
+        var vis1 = 0.5 * cbar1 + rc1.vis;
+{%- endif %}
+{%- else %}
         // The region's mean cookie up to the ray's end, per row: the channel's lit share
         // lies in [0, Cbar].
         let cbar0 = mix(filtered_load(x00, row0, CBAR), filtered_load(x01, row0, CBAR), fx0).xyz;
@@ -422,6 +481,7 @@ fn scatter_pixel(x: u32, y: u32) -> vec3<f32> {
                 }
             }
         }
+{%- endif %}
 {%- endif %}
         // Outside the row's depth range the region is exactly lit (the mean cookie) or
         // shadowed.

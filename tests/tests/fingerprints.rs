@@ -93,6 +93,15 @@ fn fingerprints(ctx: &scatter_runtime::Context) -> String {
     for v in &prefiltered {
         for f in for_light(v.light) {
             let trial = format!("prefiltered::{}::{}", v.id(), f.trial_tail());
+            // A cookie variant reads the `stained_glass` pattern, as the raymarch ones below.
+            let f = if v.cookie {
+                &f.with_cookie(
+                    scatter_reference::cookie::Cookie::pattern("stained_glass", 64)
+                        .expect("a built-in pattern"),
+                )
+            } else {
+                f
+            };
             let input = frame_input(f);
             let rectified = if v.rectification == Rectification::Projective {
                 let frame = prepare_frame(
@@ -119,7 +128,7 @@ fn fingerprints(ctx: &scatter_runtime::Context) -> String {
                     shadow_map: f.shadow_map.depth.clone(),
                     rectified,
                     pass_wall_frames: 0,
-                    cookie: None,
+                    cookie: f.cookie(),
                     vpl_maps: None,
                 },
             )

@@ -432,6 +432,12 @@ fn resume_matches_stride_one(variant: &PrefilteredVariant) -> Result<(), String>
             }
         }
     }
+    if max <= 0.0 {
+        return Err(format!(
+            "{}: a black image at both strides: the comparison would assert nothing",
+            trial_name(variant)
+        ));
+    }
     let tol = resume_tol(variant.storage) * max;
     eprintln!(
         "     {}: max |resume - stride 1| {:.3e} ({:.2e} of max {:.3e}; bar {:.1e})",
@@ -441,7 +447,10 @@ fn resume_matches_stride_one(variant: &PrefilteredVariant) -> Result<(), String>
         max,
         resume_tol(variant.storage)
     );
-    if !(worst.0 <= tol) {
+    if resumed.output.data.iter().flatten().any(|v| !v.is_finite()) {
+        return Err(format!("{}: NaN or Inf in the output", trial_name(variant)));
+    }
+    if worst.0 > tol {
         return Err(format!(
             "{}: output differs from filtered_stride = 1 by {:.3e} at pixel {} (> {:.3e} = {:.1e} of max {:.3e})",
             trial_name(variant),

@@ -824,23 +824,54 @@ void fallback_list_reset()
     return;
 }
 
-void unwarp_pixel(uint2 q_1, float4 w_2, float4 support_1, float4 depths_2, float3 light_2[4])
+uint unwarp_pixel(uint2 q_1, uint i_1, float4 w_2, float4 support_1, float4 depths_2, float3 light_2[4])
 {
     float4 _e3 = depth.Load(int3(q_1, int(0)));
     const float4 _e11 = lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(w_2, support_1, depths_2, light_2, _e3.x, DEPTH_BREAK, LIGHT_BREAK);
-    if ((_e11.w == 0.0)) {
-        uint _e18; fallback_count.InterlockedAdd(0, 1u, _e18);
-        fallback_pixels.Store(_e18*4, asuint((q_1.x | (q_1.y << 16u))));
-        if ((naga_mod(_e18, 64u) == 0u)) {
-            uint g_3 = (naga_div(_e18, 64u) + 1u);
-            uint _e38; fallback_count.InterlockedMax(4, min(g_3, FALLBACK_ROW_GROUPS), _e38);
-            uint _e47; fallback_count.InterlockedMax(8, naga_div(((g_3 + FALLBACK_ROW_GROUPS) - 1u), FALLBACK_ROW_GROUPS), _e47);
-            return;
-        } else {
-            return;
+    output[q_1] = _e11;
+    return ((_e11.w == 0.0) ? (1u << i_1) : 0u);
+}
+
+void fallback_list_block(uint2 q0_, uint side, uint listed_1)
+{
+    uint bits = (uint)0;
+    uint j_2 = 0u;
+
+    if ((listed_1 != 0u)) {
+        uint n_4 = countbits(listed_1);
+        uint _e7; fallback_count.InterlockedAdd(0, n_4, _e7);
+        bits = listed_1;
+        uint2 loop_bound_4 = uint2(4294967295u, 4294967295u);
+        bool loop_init_4 = true;
+        while(true) {
+            if (all(loop_bound_4 == uint2(0u, 0u))) { break; }
+            loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
+            if (!loop_init_4) {
+                uint _e35 = j_2;
+                j_2 = (_e35 + 1u);
+            }
+            loop_init_4 = false;
+            uint _e10 = j_2;
+            if ((_e10 < n_4)) {
+            } else {
+                break;
+            }
+            {
+                uint _e12 = bits;
+                uint i_4 = firstbitlow(_e12);
+                uint _e14 = bits;
+                uint _e15 = bits;
+                bits = (_e14 & (_e15 - 1u));
+                uint2 q_4 = (q0_ + uint2(naga_mod(i_4, side), naga_div(i_4, side)));
+                uint _e26 = j_2;
+                fallback_pixels.Store((_e7 + _e26)*4, asuint((q_4.x | (q_4.y << 16u))));
+            }
         }
+        uint g_3 = (naga_div(((_e7 + n_4) - 1u), 64u) + 1u);
+        uint _e48; fallback_count.InterlockedMax(4, min(g_3, FALLBACK_ROW_GROUPS), _e48);
+        uint _e57; fallback_count.InterlockedMax(8, naga_div(((g_3 + FALLBACK_ROW_GROUPS) - 1u), FALLBACK_ROW_GROUPS), _e57);
+        return;
     } else {
-        output[q_1] = _e11;
         return;
     }
 }
@@ -879,15 +910,16 @@ void pst_sweep_unwarp(uint3 id : SV_DispatchThreadID)
     float4 depths = float4(0.0, 0.0, 0.0, 0.0);
     float3 light[4] = (float3[4])0;
     uint j = 0u;
+    uint listed = 0u;
     uint i = 0u;
     bool local_1 = (bool)0;
 
     uint _e6 = frame.sizes.x;
     uint _e10 = frame.sizes.y;
     uint2 screen = uint2(_e6, _e10);
-    uint2 q0_ = (id.xy * UNWARP_BLOCK);
-    if (!((q0_.x >= screen.x))) {
-        local = (q0_.y >= screen.y);
+    uint2 q0_1 = (id.xy * UNWARP_BLOCK);
+    if (!((q0_1.x >= screen.x))) {
+        local = (q0_1.y >= screen.y);
     } else {
         local = true;
     }
@@ -898,21 +930,21 @@ void pst_sweep_unwarp(uint3 id : SV_DispatchThreadID)
     float4 head = epipolar_samples.Load(int3(uint2(0u, 512u), int(0)));
     float4 angles = epipolar_samples.Load(int3(uint2(1u, 512u), int(0)));
     EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX lines = ConstructEpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(head.xy, head.zw, angles.x, angles.y, naga_f2u32(angles.z));
-    float2 centre = (float2(q0_) + (1.0).xx);
+    float2 centre = (float2(q0_1) + (1.0).xx);
     const EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e51 = epipolar_block_slicesX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, centre, SLICES);
     float4 line_lo_1 = epipolar_samples.Load(int3(uint2(SLICE_SAMPLES, _e51.slices.x), int(0)));
     float4 line_hi_1 = epipolar_samples.Load(int3(uint2(SLICE_SAMPLES, _e51.slices.y), int(0)));
     const EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e67 = epipolar_block_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, centre, _e51, line_lo_1, line_hi_1, SLICE_SAMPLES);
-    uint2 loop_bound_4 = uint2(4294967295u, 4294967295u);
-    bool loop_init_4 = true;
+    uint2 loop_bound_5 = uint2(4294967295u, 4294967295u);
+    bool loop_init_5 = true;
     while(true) {
-        if (all(loop_bound_4 == uint2(0u, 0u))) { break; }
-        loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
-        if (!loop_init_4) {
+        if (all(loop_bound_5 == uint2(0u, 0u))) { break; }
+        loop_bound_5 -= uint2(loop_bound_5.y == 0u, 1u);
+        if (!loop_init_5) {
             uint _e99 = j;
             j = (_e99 + 1u);
         }
-        loop_init_4 = false;
+        loop_init_5 = false;
         uint _e69 = j;
         if ((_e69 < 4u)) {
         } else {
@@ -930,16 +962,16 @@ void pst_sweep_unwarp(uint3 id : SV_DispatchThreadID)
         }
     }
     const float4 _e104 = epipolar_block_weightsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e67, float2(0.0, 0.0));
-    uint2 loop_bound_5 = uint2(4294967295u, 4294967295u);
-    bool loop_init_5 = true;
+    uint2 loop_bound_6 = uint2(4294967295u, 4294967295u);
+    bool loop_init_6 = true;
     while(true) {
-        if (all(loop_bound_5 == uint2(0u, 0u))) { break; }
-        loop_bound_5 -= uint2(loop_bound_5.y == 0u, 1u);
-        if (!loop_init_5) {
-            uint _e137 = i;
-            i = (_e137 + 1u);
+        if (all(loop_bound_6 == uint2(0u, 0u))) { break; }
+        loop_bound_6 -= uint2(loop_bound_6.y == 0u, 1u);
+        if (!loop_init_6) {
+            uint _e142 = i;
+            i = (_e142 + 1u);
         }
-        loop_init_5 = false;
+        loop_init_6 = false;
         uint _e106 = i;
         if ((_e106 < 4u)) {
         } else {
@@ -948,20 +980,25 @@ void pst_sweep_unwarp(uint3 id : SV_DispatchThreadID)
         {
             uint _e109 = i;
             uint _e112 = i;
-            uint2 q_4 = (q0_ + uint2(naga_mod(_e109, UNWARP_BLOCK), naga_div(_e112, UNWARP_BLOCK)));
-            if ((q_4.x < screen.x)) {
-                local_1 = (q_4.y < screen.y);
+            uint2 q_5 = (q0_1 + uint2(naga_mod(_e109, UNWARP_BLOCK), naga_div(_e112, UNWARP_BLOCK)));
+            if ((q_5.x < screen.x)) {
+                local_1 = (q_5.y < screen.y);
             } else {
                 local_1 = false;
             }
             bool _e126 = local_1;
             if (_e126) {
-                const float4 _e133 = epipolar_block_weightsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e67, ((float2(q_4) + float2(0.5, 0.5)) - centre));
-                float4 _e134 = depths;
-                float3 _e135[4] = light;
-                unwarp_pixel(q_4, _e133, _e104, _e134, _e135);
+                const float4 _e133 = epipolar_block_weightsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e67, ((float2(q_5) + float2(0.5, 0.5)) - centre));
+                uint _e135 = listed;
+                uint _e136 = i;
+                float4 _e137 = depths;
+                float3 _e138[4] = light;
+                const uint _e139 = unwarp_pixel(q_5, _e136, _e133, _e104, _e137, _e138);
+                listed = (_e135 | _e139);
             }
         }
     }
+    uint _e144 = listed;
+    fallback_list_block(q0_1, UNWARP_BLOCK, _e144);
     return;
 }

@@ -944,34 +944,68 @@ void fallback_list_reset(
     return;
 }
 
-void unwarp_pixel(
+uint unwarp_pixel(
     metal::uint2 q_1,
+    uint i_1,
     metal::float4 w_2,
     metal::float4 support_1,
     metal::float4 depths_2,
     type_9 light_2,
     metal::texture2d<float, metal::access::sample> depth,
-    metal::texture2d<float, metal::access::write> output,
-    device FallbackCount& fallback_count,
-    device type_13& fallback_pixels,
-    constant _mslBufferSizes& _buffer_sizes
+    metal::texture2d<float, metal::access::write> output
 ) {
     uint clamped_lod_e3 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
     metal::float4 _e3 = depth.read(metal::min(metal::uint2(q_1), metal::uint2(depth.get_width(clamped_lod_e3), depth.get_height(clamped_lod_e3)) - 1), clamped_lod_e3);
     metal::float4 _e11 = lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(w_2, support_1, depths_2, light_2, _e3.x, DEPTH_BREAK, LIGHT_BREAK);
-    if (_e11.w == 0.0) {
-        uint _e18 = metal::atomic_fetch_add_explicit(&fallback_count.listed, 1u, metal::memory_order_relaxed);
-        fallback_pixels[metal::min(unsigned(_e18), (_buffer_sizes.size9 - 0 - 4) / 4)] = q_1.x | (q_1.y << 16u);
-        if (naga_mod(_e18, 64u) == 0u) {
-            uint g_3 = naga_div(_e18, 64u) + 1u;
-            uint _e38 = metal::atomic_fetch_max_explicit(&fallback_count.groups_x, metal::min(g_3, FALLBACK_ROW_GROUPS), metal::memory_order_relaxed);
-            uint _e47 = metal::atomic_fetch_max_explicit(&fallback_count.groups_y, naga_div((g_3 + FALLBACK_ROW_GROUPS) - 1u, FALLBACK_ROW_GROUPS), metal::memory_order_relaxed);
-            return;
-        } else {
-            return;
+    output.write(_e11, metal::uint2(q_1));
+    return (_e11.w == 0.0) ? (1u << i_1) : 0u;
+}
+
+void fallback_list_block(
+    metal::uint2 q0_,
+    uint side,
+    uint listed_1,
+    device FallbackCount& fallback_count,
+    device type_13& fallback_pixels,
+    constant _mslBufferSizes& _buffer_sizes
+) {
+    uint bits = {};
+    uint j_2 = 0u;
+    if (listed_1 != 0u) {
+        uint n_4 = metal::popcount(listed_1);
+        uint _e7 = metal::atomic_fetch_add_explicit(&fallback_count.listed, n_4, metal::memory_order_relaxed);
+        bits = listed_1;
+        uint2 loop_bound_4 = uint2(4294967295u);
+        bool loop_init_4 = true;
+        while(true) {
+            if (metal::all(loop_bound_4 == uint2(0u))) { break; }
+            loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
+            if (!loop_init_4) {
+                uint _e35 = j_2;
+                j_2 = _e35 + 1u;
+            }
+            loop_init_4 = false;
+            uint _e10 = j_2;
+            if (_e10 < n_4) {
+            } else {
+                break;
+            }
+            {
+                uint _e12 = bits;
+                uint i_4 = (((metal::ctz(_e12) + 1) % 33) - 1);
+                uint _e14 = bits;
+                uint _e15 = bits;
+                bits = _e14 & (_e15 - 1u);
+                metal::uint2 q_4 = q0_ + metal::uint2(naga_mod(i_4, side), naga_div(i_4, side));
+                uint _e26 = j_2;
+                fallback_pixels[metal::min(unsigned(_e7 + _e26), (_buffer_sizes.size9 - 0 - 4) / 4)] = q_4.x | (q_4.y << 16u);
+            }
         }
+        uint g_3 = naga_div((_e7 + n_4) - 1u, 64u) + 1u;
+        uint _e48 = metal::atomic_fetch_max_explicit(&fallback_count.groups_x, metal::min(g_3, FALLBACK_ROW_GROUPS), metal::memory_order_relaxed);
+        uint _e57 = metal::atomic_fetch_max_explicit(&fallback_count.groups_y, naga_div((g_3 + FALLBACK_ROW_GROUPS) - 1u, FALLBACK_ROW_GROUPS), metal::memory_order_relaxed);
+        return;
     } else {
-        output.write(_e11, metal::uint2(q_1));
         return;
     }
 }
@@ -984,10 +1018,10 @@ metal::float4 factor_at(
     constant _mslBufferSizes& _buffer_sizes
 ) {
     float p_6 = metal::min(metal::clamp(x_5, 0.0, 1.0) * 95.0, 95.0);
-    uint j_2 = metal::min(naga_f2u32(metal::floor(p_6)), 94u);
-    float t_6 = p_6 - static_cast<float>(j_2);
-    metal::float4 _e22 = pst_factors[metal::min(unsigned((base_1 + (2u * j_2)) + h), (_buffer_sizes.size5 - 0 - 16) / 16)];
-    metal::float4 _e34 = pst_factors[metal::min(unsigned((base_1 + (2u * (j_2 + 1u))) + h), (_buffer_sizes.size5 - 0 - 16) / 16)];
+    uint j_3 = metal::min(naga_f2u32(metal::floor(p_6)), 94u);
+    float t_6 = p_6 - static_cast<float>(j_3);
+    metal::float4 _e22 = pst_factors[metal::min(unsigned((base_1 + (2u * j_3)) + h), (_buffer_sizes.size5 - 0 - 16) / 16)];
+    metal::float4 _e34 = pst_factors[metal::min(unsigned((base_1 + (2u * (j_3 + 1u))) + h), (_buffer_sizes.size5 - 0 - 16) / 16)];
     return (_e22 * (1.0 - t_6)) + (_e34 * t_6);
 }
 
@@ -1027,7 +1061,7 @@ metal::float3 pst_row_e(
 
 metal::float4 pst_leaf(
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_20,
-    uint i_1,
+    uint i_2,
     metal::float3 e_1,
     float delta_2,
     uint h_3,
@@ -1037,20 +1071,20 @@ metal::float4 pst_leaf(
     metal::float4 leaf = metal::float4(0.0, 0.0, 0.0, 0.0);
     uint g_1 = 0u;
     if (false) {
-        metal::float4 _e9 = gamma_at(static_cast<float>(i_1) * delta_2, h_3, pst_factors, _buffer_sizes);
+        metal::float4 _e9 = gamma_at(static_cast<float>(i_2) * delta_2, h_3, pst_factors, _buffer_sizes);
         return _e9;
     }
     metal::float3 axis_2 = f_20.axis.xyz;
-    uint2 loop_bound_4 = uint2(4294967295u);
-    bool loop_init_4 = true;
+    uint2 loop_bound_5 = uint2(4294967295u);
+    bool loop_init_5 = true;
     while(true) {
-        if (metal::all(loop_bound_4 == uint2(0u))) { break; }
-        loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
-        if (!loop_init_4) {
+        if (metal::all(loop_bound_5 == uint2(0u))) { break; }
+        loop_bound_5 -= uint2(loop_bound_5.y == 0u, 1u);
+        if (!loop_init_5) {
             uint _e54 = g_1;
             g_1 = _e54 + 1u;
         }
-        loop_init_4 = false;
+        loop_init_5 = false;
         uint _e14 = g_1;
         if (_e14 < 2u) {
         } else {
@@ -1058,8 +1092,8 @@ metal::float4 pst_leaf(
         }
         {
             uint _e17 = g_1;
-            float q_4 = (_e17 == 0u) ? -0.57735026 : GL2_;
-            float psi_1 = ((static_cast<float>(i_1) + 0.5) + (0.5 * q_4)) * delta_2;
+            float q_5 = (_e17 == 0u) ? -0.57735026 : GL2_;
+            float psi_1 = ((static_cast<float>(i_2) + 0.5) + (0.5 * q_5)) * delta_2;
             metal::float3 l_3 = (-(axis_2) * metal::cos(psi_1)) + (e_1 * metal::sin(psi_1));
             float _e44 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(metal::dot(l_3, f_20.light_dir.xyz), f_20.light_pos.w, f_20.light_dir.w);
             metal::float4 _e46 = leaf;
@@ -1160,7 +1194,7 @@ metal::float3 pst_sweep_pixel(
     float sum_3 = 0.0;
     uint h_4 = 0u;
     metal::float4 p_4 = {};
-    uint i_2 = {};
+    uint i_3 = {};
     FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX f_24 = frame;
     uint clamped_lod_e16 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
     metal::float4 _e16 = depth.read(metal::min(metal::uint2(metal::uint2(x_6, y)), metal::uint2(depth.get_width(clamped_lod_e16), depth.get_height(clamped_lod_e16)) - 1), clamped_lod_e16);
@@ -1176,16 +1210,16 @@ metal::float3 pst_sweep_pixel(
     if (_e29 == 0u) {
         return metal::float3(0.0, 0.0, 0.0);
     }
-    uint2 loop_bound_5 = uint2(4294967295u);
-    bool loop_init_5 = true;
+    uint2 loop_bound_6 = uint2(4294967295u);
+    bool loop_init_6 = true;
     while(true) {
-        if (metal::all(loop_bound_5 == uint2(0u))) { break; }
-        loop_bound_5 -= uint2(loop_bound_5.y == 0u, 1u);
-        if (!loop_init_5) {
+        if (metal::all(loop_bound_6 == uint2(0u))) { break; }
+        loop_bound_6 -= uint2(loop_bound_6.y == 0u, 1u);
+        if (!loop_init_6) {
             uint _e78 = h_4;
             h_4 = _e78 + 1u;
         }
-        loop_init_5 = false;
+        loop_init_6 = false;
         uint _e37 = h_4;
         if (_e37 < RANK_VECS) {
         } else {
@@ -1193,29 +1227,29 @@ metal::float3 pst_sweep_pixel(
         }
         {
             p_4 = metal::float4(0.0, 0.0, 0.0, 0.0);
-            i_2 = 0u;
-            uint2 loop_bound_6 = uint2(4294967295u);
-            bool loop_init_6 = true;
+            i_3 = 0u;
+            uint2 loop_bound_7 = uint2(4294967295u);
+            bool loop_init_7 = true;
             while(true) {
-                if (metal::all(loop_bound_6 == uint2(0u))) { break; }
-                loop_bound_6 -= uint2(loop_bound_6.y == 0u, 1u);
-                if (!loop_init_6) {
-                    uint _e67 = i_2;
-                    i_2 = _e67 + 1u;
+                if (metal::all(loop_bound_7 == uint2(0u))) { break; }
+                loop_bound_7 -= uint2(loop_bound_7.y == 0u, 1u);
+                if (!loop_init_7) {
+                    uint _e67 = i_3;
+                    i_3 = _e67 + 1u;
                 }
-                loop_init_6 = false;
-                uint _e48 = i_2;
+                loop_init_7 = false;
+                uint _e48 = i_3;
                 if ((_e48 + 1u) < _e29) {
                 } else {
                     break;
                 }
                 {
-                    uint _e53 = i_2;
+                    uint _e53 = i_3;
                     uint clamped_lod_e58 = metal::min(uint(0), rectified.get_num_mip_levels() - 1);
                     metal::float4 _e58 = rectified.read(metal::min(metal::uint2(metal::uint2(_e53, _e18.row)), metal::uint2(rectified.get_width(clamped_lod_e58), rectified.get_height(clamped_lod_e58)) - 1), clamped_lod_e58);
                     if (_e18.d <= _e58.x) {
                         metal::float4 _e61 = p_4;
-                        uint _e62 = i_2;
+                        uint _e62 = i_3;
                         uint _e63 = h_4;
                         metal::float4 _e64 = pst_leaf(f_24, _e62, _e28, delta_5, _e63, pst_factors, _buffer_sizes);
                         p_4 = _e61 + _e64;
@@ -1250,14 +1284,15 @@ kernel void pst_sweep_unwarp(
     metal::float4 depths = metal::float4(0.0, 0.0, 0.0, 0.0);
     type_9 light = {};
     uint j = 0u;
+    uint listed = 0u;
     uint i = 0u;
     bool local_1 = {};
     uint _e6 = frame.sizes.x;
     uint _e10 = frame.sizes.y;
     metal::uint2 screen = metal::uint2(_e6, _e10);
-    metal::uint2 q0_ = id.xy * UNWARP_BLOCK;
-    if (!((q0_.x >= screen.x))) {
-        local = q0_.y >= screen.y;
+    metal::uint2 q0_1 = id.xy * UNWARP_BLOCK;
+    if (!((q0_1.x >= screen.x))) {
+        local = q0_1.y >= screen.y;
     } else {
         local = true;
     }
@@ -1270,23 +1305,23 @@ kernel void pst_sweep_unwarp(
     uint clamped_lod_e38 = metal::min(uint(0), epipolar_samples.get_num_mip_levels() - 1);
     metal::float4 angles = epipolar_samples.read(metal::min(metal::uint2(metal::uint2(1u, 512u)), metal::uint2(epipolar_samples.get_width(clamped_lod_e38), epipolar_samples.get_height(clamped_lod_e38)) - 1), clamped_lod_e38);
     EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX lines = EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {head_1.xy, head_1.zw, angles.x, angles.y, naga_f2u32(angles.z)};
-    metal::float2 centre = static_cast<metal::float2>(q0_) + metal::float2(1.0);
+    metal::float2 centre = static_cast<metal::float2>(q0_1) + metal::float2(1.0);
     EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e51 = epipolar_block_slicesX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, centre, SLICES);
     uint clamped_lod_e58 = metal::min(uint(0), epipolar_samples.get_num_mip_levels() - 1);
     metal::float4 line_lo_1 = epipolar_samples.read(metal::min(metal::uint2(metal::uint2(SLICE_SAMPLES, _e51.slices.x)), metal::uint2(epipolar_samples.get_width(clamped_lod_e58), epipolar_samples.get_height(clamped_lod_e58)) - 1), clamped_lod_e58);
     uint clamped_lod_e65 = metal::min(uint(0), epipolar_samples.get_num_mip_levels() - 1);
     metal::float4 line_hi_1 = epipolar_samples.read(metal::min(metal::uint2(metal::uint2(SLICE_SAMPLES, _e51.slices.y)), metal::uint2(epipolar_samples.get_width(clamped_lod_e65), epipolar_samples.get_height(clamped_lod_e65)) - 1), clamped_lod_e65);
     EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e67 = epipolar_block_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, centre, _e51, line_lo_1, line_hi_1, SLICE_SAMPLES);
-    uint2 loop_bound_7 = uint2(4294967295u);
-    bool loop_init_7 = true;
+    uint2 loop_bound_8 = uint2(4294967295u);
+    bool loop_init_8 = true;
     while(true) {
-        if (metal::all(loop_bound_7 == uint2(0u))) { break; }
-        loop_bound_7 -= uint2(loop_bound_7.y == 0u, 1u);
-        if (!loop_init_7) {
+        if (metal::all(loop_bound_8 == uint2(0u))) { break; }
+        loop_bound_8 -= uint2(loop_bound_8.y == 0u, 1u);
+        if (!loop_init_8) {
             uint _e99 = j;
             j = _e99 + 1u;
         }
-        loop_init_7 = false;
+        loop_init_8 = false;
         uint _e69 = j;
         if (_e69 < 4u) {
         } else {
@@ -1305,16 +1340,16 @@ kernel void pst_sweep_unwarp(
         }
     }
     metal::float4 _e104 = epipolar_block_weightsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e67, metal::float2(0.0, 0.0));
-    uint2 loop_bound_8 = uint2(4294967295u);
-    bool loop_init_8 = true;
+    uint2 loop_bound_9 = uint2(4294967295u);
+    bool loop_init_9 = true;
     while(true) {
-        if (metal::all(loop_bound_8 == uint2(0u))) { break; }
-        loop_bound_8 -= uint2(loop_bound_8.y == 0u, 1u);
-        if (!loop_init_8) {
-            uint _e137 = i;
-            i = _e137 + 1u;
+        if (metal::all(loop_bound_9 == uint2(0u))) { break; }
+        loop_bound_9 -= uint2(loop_bound_9.y == 0u, 1u);
+        if (!loop_init_9) {
+            uint _e142 = i;
+            i = _e142 + 1u;
         }
-        loop_init_8 = false;
+        loop_init_9 = false;
         uint _e106 = i;
         if (_e106 < 4u) {
         } else {
@@ -1323,20 +1358,25 @@ kernel void pst_sweep_unwarp(
         {
             uint _e109 = i;
             uint _e112 = i;
-            metal::uint2 q_5 = q0_ + metal::uint2(naga_mod(_e109, UNWARP_BLOCK), naga_div(_e112, UNWARP_BLOCK));
-            if (q_5.x < screen.x) {
-                local_1 = q_5.y < screen.y;
+            metal::uint2 q_6 = q0_1 + metal::uint2(naga_mod(_e109, UNWARP_BLOCK), naga_div(_e112, UNWARP_BLOCK));
+            if (q_6.x < screen.x) {
+                local_1 = q_6.y < screen.y;
             } else {
                 local_1 = false;
             }
             bool _e126 = local_1;
             if (_e126) {
-                metal::float4 _e133 = epipolar_block_weightsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e67, (static_cast<metal::float2>(q_5) + metal::float2(0.5, 0.5)) - centre);
-                metal::float4 _e134 = depths;
-                type_9 _e135 = light;
-                unwarp_pixel(q_5, _e133, _e104, _e134, _e135, depth, output, fallback_count, fallback_pixels, _buffer_sizes);
+                metal::float4 _e133 = epipolar_block_weightsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e67, (static_cast<metal::float2>(q_6) + metal::float2(0.5, 0.5)) - centre);
+                uint _e135 = listed;
+                uint _e136 = i;
+                metal::float4 _e137 = depths;
+                type_9 _e138 = light;
+                uint _e139 = unwarp_pixel(q_6, _e136, _e133, _e104, _e137, _e138, depth, output);
+                listed = _e135 | _e139;
             }
         }
     }
+    uint _e144 = listed;
+    fallback_list_block(q0_1, UNWARP_BLOCK, _e144, fallback_count, fallback_pixels, _buffer_sizes);
     return;
 }

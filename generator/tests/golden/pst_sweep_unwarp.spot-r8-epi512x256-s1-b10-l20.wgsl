@@ -705,32 +705,57 @@ fn fallback_list_reset() {
     return;
 }
 
-fn unwarp_pixel(q_1: vec2<u32>, w_2: vec4<f32>, support_1: vec4<f32>, depths_2: vec4<f32>, light_2: array<vec3<f32>, 4>) {
+fn unwarp_pixel(q_1: vec2<u32>, i_1: u32, w_2: vec4<f32>, support_1: vec4<f32>, depths_2: vec4<f32>, light_2: array<vec3<f32>, 4>) -> u32 {
     let _e3 = textureLoad(depth, q_1, 0i);
     let _e11 = lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(w_2, support_1, depths_2, light_2, _e3.x, DEPTH_BREAK, LIGHT_BREAK);
-    if (_e11.w == 0f) {
-        let _e18 = atomicAdd((&fallback_count.listed), 1u);
-        fallback_pixels[_e18] = (q_1.x | (q_1.y << 16u));
-        if ((_e18 % 64u) == 0u) {
-            let g_3 = ((_e18 / 64u) + 1u);
-            let _e38 = atomicMax((&fallback_count.groups_x), min(g_3, FALLBACK_ROW_GROUPS));
-            let _e47 = atomicMax((&fallback_count.groups_y), (((g_3 + FALLBACK_ROW_GROUPS) - 1u) / FALLBACK_ROW_GROUPS));
-            return;
-        } else {
-            return;
+    textureStore(output, q_1, _e11);
+    return select(0u, (1u << i_1), (_e11.w == 0f));
+}
+
+fn fallback_list_block(q0_: vec2<u32>, side: u32, listed_1: u32) {
+    var bits: u32;
+    var j_2: u32 = 0u;
+
+    if (listed_1 != 0u) {
+        let n_4 = countOneBits(listed_1);
+        let _e7 = atomicAdd((&fallback_count.listed), n_4);
+        bits = listed_1;
+        loop {
+            let _e10 = j_2;
+            if (_e10 < n_4) {
+            } else {
+                break;
+            }
+            {
+                let _e12 = bits;
+                let i_4 = firstTrailingBit(_e12);
+                let _e14 = bits;
+                let _e15 = bits;
+                bits = (_e14 & (_e15 - 1u));
+                let q_4 = (q0_ + vec2<u32>((i_4 % side), (i_4 / side)));
+                let _e26 = j_2;
+                fallback_pixels[(_e7 + _e26)] = (q_4.x | (q_4.y << 16u));
+            }
+            continuing {
+                let _e35 = j_2;
+                j_2 = (_e35 + 1u);
+            }
         }
+        let g_3 = ((((_e7 + n_4) - 1u) / 64u) + 1u);
+        let _e48 = atomicMax((&fallback_count.groups_x), min(g_3, FALLBACK_ROW_GROUPS));
+        let _e57 = atomicMax((&fallback_count.groups_y), (((g_3 + FALLBACK_ROW_GROUPS) - 1u) / FALLBACK_ROW_GROUPS));
+        return;
     } else {
-        textureStore(output, q_1, _e11);
         return;
     }
 }
 
 fn factor_at(base_1: u32, x_5: f32, h: u32) -> vec4<f32> {
     let p_6 = min((clamp(x_5, 0f, 1f) * 95f), 95f);
-    let j_2 = min(u32(floor(p_6)), 94u);
-    let t_6 = (p_6 - f32(j_2));
-    let _e22 = pst_factors[((base_1 + (2u * j_2)) + h)];
-    let _e34 = pst_factors[((base_1 + (2u * (j_2 + 1u))) + h)];
+    let j_3 = min(u32(floor(p_6)), 94u);
+    let t_6 = (p_6 - f32(j_3));
+    let _e22 = pst_factors[((base_1 + (2u * j_3)) + h)];
+    let _e34 = pst_factors[((base_1 + (2u * (j_3 + 1u))) + h)];
     return ((_e22 * (1f - t_6)) + (_e34 * t_6));
 }
 
@@ -755,12 +780,12 @@ fn pst_row_e(f_19: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, row_3: u3
     return _e8;
 }
 
-fn pst_leaf(f_20: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, i_1: u32, e_1: vec3<f32>, delta_2: f32, h_3: u32) -> vec4<f32> {
+fn pst_leaf(f_20: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, i_2: u32, e_1: vec3<f32>, delta_2: f32, h_3: u32) -> vec4<f32> {
     var leaf: vec4<f32> = vec4<f32>(0f, 0f, 0f, 0f);
     var g_1: u32 = 0u;
 
     if false {
-        let _e9 = gamma_at((f32(i_1) * delta_2), h_3);
+        let _e9 = gamma_at((f32(i_2) * delta_2), h_3);
         return _e9;
     }
     let axis_2 = f_20.axis.xyz;
@@ -772,8 +797,8 @@ fn pst_leaf(f_20: FrameX_naga_oil_mod_XONRWC5DUMVZDUOTFOBUXA33MMFZAX, i_1: u32, 
         }
         {
             let _e17 = g_1;
-            let q_4 = select(GL2_, -0.57735026f, (_e17 == 0u));
-            let psi_1 = (((f32(i_1) + 0.5f) + (0.5f * q_4)) * delta_2);
+            let q_5 = select(GL2_, -0.57735026f, (_e17 == 0u));
+            let psi_1 = (((f32(i_2) + 0.5f) + (0.5f * q_5)) * delta_2);
             let l_3 = ((-(axis_2) * cos(psi_1)) + (e_1 * sin(psi_1)));
             let _e44 = cone_falloffX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(dot(l_3, f_20.light_dir.xyz), f_20.light_pos.w, f_20.light_dir.w);
             let _e46 = leaf;
@@ -853,7 +878,7 @@ fn pst_sweep_pixel(x_6: u32, y: u32) -> vec3<f32> {
     var sum_3: f32 = 0f;
     var h_4: u32 = 0u;
     var p_4: vec4<f32>;
-    var i_2: u32;
+    var i_3: u32;
 
     let f_24 = frame;
     let _e16 = textureLoad(depth, vec2<u32>(x_6, y), 0i);
@@ -877,27 +902,27 @@ fn pst_sweep_pixel(x_6: u32, y: u32) -> vec3<f32> {
         }
         {
             p_4 = vec4<f32>(0f, 0f, 0f, 0f);
-            i_2 = 0u;
+            i_3 = 0u;
             loop {
-                let _e48 = i_2;
+                let _e48 = i_3;
                 if ((_e48 + 1u) < _e29) {
                 } else {
                     break;
                 }
                 {
-                    let _e53 = i_2;
+                    let _e53 = i_3;
                     let _e58 = textureLoad(rectified, vec2<u32>(_e53, _e18.row), 0i);
                     if (_e18.d <= _e58.x) {
                         let _e61 = p_4;
-                        let _e62 = i_2;
+                        let _e62 = i_3;
                         let _e63 = h_4;
                         let _e64 = pst_leaf(f_24, _e62, _e28, delta_5, _e63);
                         p_4 = (_e61 + _e64);
                     }
                 }
                 continuing {
-                    let _e67 = i_2;
-                    i_2 = (_e67 + 1u);
+                    let _e67 = i_3;
+                    i_3 = (_e67 + 1u);
                 }
             }
             let _e70 = sum_3;
@@ -922,15 +947,16 @@ fn pst_sweep_unwarp(@builtin(global_invocation_id) id: vec3<u32>) {
     var depths: vec4<f32> = vec4<f32>(0f, 0f, 0f, 0f);
     var light: array<vec3<f32>, 4>;
     var j: u32 = 0u;
+    var listed: u32 = 0u;
     var i: u32 = 0u;
     var local_1: bool;
 
     let _e6 = frame.sizes.x;
     let _e10 = frame.sizes.y;
     let screen = vec2<u32>(_e6, _e10);
-    let q0_ = (id.xy * UNWARP_BLOCK);
-    if !((q0_.x >= screen.x)) {
-        local = (q0_.y >= screen.y);
+    let q0_1 = (id.xy * UNWARP_BLOCK);
+    if !((q0_1.x >= screen.x)) {
+        local = (q0_1.y >= screen.y);
     } else {
         local = true;
     }
@@ -941,7 +967,7 @@ fn pst_sweep_unwarp(@builtin(global_invocation_id) id: vec3<u32>) {
     let head_1 = textureLoad(epipolar_samples, vec2<u32>(0u, 512u), 0i);
     let angles = textureLoad(epipolar_samples, vec2<u32>(1u, 512u), 0i);
     let lines = EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(head_1.xy, head_1.zw, angles.x, angles.y, u32(angles.z));
-    let centre = (vec2<f32>(q0_) + vec2(1f));
+    let centre = (vec2<f32>(q0_1) + vec2(1f));
     let _e51 = epipolar_block_slicesX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, centre, SLICES);
     let line_lo_1 = textureLoad(epipolar_samples, vec2<u32>(SLICE_SAMPLES, _e51.slices.x), 0i);
     let line_hi_1 = textureLoad(epipolar_samples, vec2<u32>(SLICE_SAMPLES, _e51.slices.y), 0i);
@@ -977,24 +1003,29 @@ fn pst_sweep_unwarp(@builtin(global_invocation_id) id: vec3<u32>) {
         {
             let _e109 = i;
             let _e112 = i;
-            let q_5 = (q0_ + vec2<u32>((_e109 % UNWARP_BLOCK), (_e112 / UNWARP_BLOCK)));
-            if (q_5.x < screen.x) {
-                local_1 = (q_5.y < screen.y);
+            let q_6 = (q0_1 + vec2<u32>((_e109 % UNWARP_BLOCK), (_e112 / UNWARP_BLOCK)));
+            if (q_6.x < screen.x) {
+                local_1 = (q_6.y < screen.y);
             } else {
                 local_1 = false;
             }
             let _e126 = local_1;
             if _e126 {
-                let _e133 = epipolar_block_weightsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e67, ((vec2<f32>(q_5) + vec2<f32>(0.5f, 0.5f)) - centre));
-                let _e134 = depths;
-                let _e135 = light;
-                unwarp_pixel(q_5, _e133, _e104, _e134, _e135);
+                let _e133 = epipolar_block_weightsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e67, ((vec2<f32>(q_6) + vec2<f32>(0.5f, 0.5f)) - centre));
+                let _e135 = listed;
+                let _e136 = i;
+                let _e137 = depths;
+                let _e138 = light;
+                let _e139 = unwarp_pixel(q_6, _e136, _e133, _e104, _e137, _e138);
+                listed = (_e135 | _e139);
             }
         }
         continuing {
-            let _e137 = i;
-            i = (_e137 + 1u);
+            let _e142 = i;
+            i = (_e142 + 1u);
         }
     }
+    let _e144 = listed;
+    fallback_list_block(q0_1, UNWARP_BLOCK, _e144);
     return;
 }

@@ -393,23 +393,49 @@ void fallback_list_reset() {
     return;
 }
 
-void unwarp_pixel(uvec2 q, vec4 w_1, vec4 support_1, vec4 depths_2, vec3 light_2[4]) {
+uint unwarp_pixel(uvec2 q, uint i_1, vec4 w_1, vec4 support_1, vec4 depths_2, vec3 light_2[4]) {
     int _e3_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_1_cs) - 1);
     vec4 _e3 = texelFetch(_group_0_binding_1_cs, clamp(ivec2(q), ivec2(0), textureSize(_group_0_binding_1_cs, _e3_clamped_lod) - ivec2(1)), _e3_clamped_lod);
     vec4 _e11 = lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(w_1, support_1, depths_2, light_2, _e3.x, DEPTH_BREAK, LIGHT_BREAK);
-    if ((_e11.w == 0.0)) {
-        uint _e18 = atomicAdd(_group_0_binding_5_cs.listed, 1u);
-        _group_0_binding_6_cs[_e18] = (q.x | (q.y << 16u));
-        if (((_e18 % 64u) == 0u)) {
-            uint g_2 = ((_e18 / 64u) + 1u);
-            uint _e38 = atomicMax(_group_0_binding_5_cs.groups_x, min(g_2, FALLBACK_ROW_GROUPS));
-            uint _e47 = atomicMax(_group_0_binding_5_cs.groups_y, (((g_2 + FALLBACK_ROW_GROUPS) - 1u) / FALLBACK_ROW_GROUPS));
-            return;
-        } else {
-            return;
+    imageStore(_group_0_binding_3_cs, ivec2(q), _e11);
+    return ((_e11.w == 0.0) ? (1u << i_1) : 0u);
+}
+
+void fallback_list_block(uvec2 q0_, uint side, uint listed_1) {
+    uint bits = 0u;
+    uint j_1 = 0u;
+    if ((listed_1 != 0u)) {
+        uint n_2 = uint(bitCount(listed_1));
+        uint _e7 = atomicAdd(_group_0_binding_5_cs.listed, n_2);
+        bits = listed_1;
+        bool loop_init_1 = true;
+        while(true) {
+            if (!loop_init_1) {
+                uint _e35 = j_1;
+                j_1 = (_e35 + 1u);
+            }
+            loop_init_1 = false;
+            uint _e10 = j_1;
+            if ((_e10 < n_2)) {
+            } else {
+                break;
+            }
+            {
+                uint _e12 = bits;
+                uint i_2 = uint(findLSB(_e12));
+                uint _e14 = bits;
+                uint _e15 = bits;
+                bits = (_e14 & (_e15 - 1u));
+                uvec2 q_2 = (q0_ + uvec2((i_2 % side), (i_2 / side)));
+                uint _e26 = j_1;
+                _group_0_binding_6_cs[(_e7 + _e26)] = (q_2.x | (q_2.y << 16u));
+            }
         }
+        uint g_2 = ((((_e7 + n_2) - 1u) / 64u) + 1u);
+        uint _e48 = atomicMax(_group_0_binding_5_cs.groups_x, min(g_2, FALLBACK_ROW_GROUPS));
+        uint _e57 = atomicMax(_group_0_binding_5_cs.groups_y, (((g_2 + FALLBACK_ROW_GROUPS) - 1u) / FALLBACK_ROW_GROUPS));
+        return;
     } else {
-        imageStore(_group_0_binding_3_cs, ivec2(q), _e11);
         return;
     }
 }
@@ -420,14 +446,15 @@ void main() {
     vec4 depths = vec4(0.0, 0.0, 0.0, 0.0);
     vec3 light[4] = vec3[4](vec3(0.0), vec3(0.0), vec3(0.0), vec3(0.0));
     uint j = 0u;
+    uint listed = 0u;
     uint i = 0u;
     bool local_1 = false;
     uint _e6 = _group_0_binding_0_cs.sizes.x;
     uint _e10 = _group_0_binding_0_cs.sizes.y;
     uvec2 screen = uvec2(_e6, _e10);
-    uvec2 q0_ = (id.xy * UNWARP_BLOCK);
-    if (!((q0_.x >= screen.x))) {
-        local = (q0_.y >= screen.y);
+    uvec2 q0_1 = (id.xy * UNWARP_BLOCK);
+    if (!((q0_1.x >= screen.x))) {
+        local = (q0_1.y >= screen.y);
     } else {
         local = true;
     }
@@ -440,20 +467,20 @@ void main() {
     int _e38_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
     vec4 angles = texelFetch(_group_0_binding_4_cs, clamp(ivec2(uvec2(1u, 256u)), ivec2(0), textureSize(_group_0_binding_4_cs, _e38_clamped_lod) - ivec2(1)), _e38_clamped_lod);
     EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX lines = EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(head.xy, head.zw, angles.x, angles.y, uint(angles.z));
-    vec2 centre = (vec2(q0_) + vec2(1.0));
+    vec2 centre = (vec2(q0_1) + vec2(1.0));
     EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e51 = epipolar_block_slicesX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, centre, SLICES);
     int _e58_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
     vec4 line_lo_1 = texelFetch(_group_0_binding_4_cs, clamp(ivec2(uvec2(SLICE_SAMPLES, _e51.slices.x)), ivec2(0), textureSize(_group_0_binding_4_cs, _e58_clamped_lod) - ivec2(1)), _e58_clamped_lod);
     int _e65_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_4_cs) - 1);
     vec4 line_hi_1 = texelFetch(_group_0_binding_4_cs, clamp(ivec2(uvec2(SLICE_SAMPLES, _e51.slices.y)), ivec2(0), textureSize(_group_0_binding_4_cs, _e65_clamped_lod) - ivec2(1)), _e65_clamped_lod);
     EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e67 = epipolar_block_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, centre, _e51, line_lo_1, line_hi_1, SLICE_SAMPLES);
-    bool loop_init_1 = true;
+    bool loop_init_2 = true;
     while(true) {
-        if (!loop_init_1) {
+        if (!loop_init_2) {
             uint _e99 = j;
             j = (_e99 + 1u);
         }
-        loop_init_1 = false;
+        loop_init_2 = false;
         uint _e69 = j;
         if ((_e69 < 4u)) {
         } else {
@@ -472,13 +499,13 @@ void main() {
         }
     }
     vec4 _e104 = epipolar_block_weightsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e67, vec2(0.0, 0.0));
-    bool loop_init_2 = true;
+    bool loop_init_3 = true;
     while(true) {
-        if (!loop_init_2) {
-            uint _e137 = i;
-            i = (_e137 + 1u);
+        if (!loop_init_3) {
+            uint _e142 = i;
+            i = (_e142 + 1u);
         }
-        loop_init_2 = false;
+        loop_init_3 = false;
         uint _e106 = i;
         if ((_e106 < 4u)) {
         } else {
@@ -487,21 +514,26 @@ void main() {
         {
             uint _e109 = i;
             uint _e112 = i;
-            uvec2 q_2 = (q0_ + uvec2((_e109 % UNWARP_BLOCK), (_e112 / UNWARP_BLOCK)));
-            if ((q_2.x < screen.x)) {
-                local_1 = (q_2.y < screen.y);
+            uvec2 q_3 = (q0_1 + uvec2((_e109 % UNWARP_BLOCK), (_e112 / UNWARP_BLOCK)));
+            if ((q_3.x < screen.x)) {
+                local_1 = (q_3.y < screen.y);
             } else {
                 local_1 = false;
             }
             bool _e126 = local_1;
             if (_e126) {
-                vec4 _e133 = epipolar_block_weightsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e67, ((vec2(q_2) + vec2(0.5, 0.5)) - centre));
-                vec4 _e134 = depths;
-                vec3 _e135[4] = light;
-                unwarp_pixel(q_2, _e133, _e104, _e134, _e135);
+                vec4 _e133 = epipolar_block_weightsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e67, ((vec2(q_3) + vec2(0.5, 0.5)) - centre));
+                uint _e135 = listed;
+                uint _e136 = i;
+                vec4 _e137 = depths;
+                vec3 _e138[4] = light;
+                uint _e139 = unwarp_pixel(q_3, _e136, _e133, _e104, _e137, _e138);
+                listed = (_e135 | _e139);
             }
         }
     }
+    uint _e144 = listed;
+    fallback_list_block(q0_1, UNWARP_BLOCK, _e144);
     return;
 }
 

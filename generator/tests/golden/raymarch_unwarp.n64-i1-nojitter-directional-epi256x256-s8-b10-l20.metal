@@ -506,38 +506,72 @@ void fallback_list_reset(
     return;
 }
 
-uint naga_div(uint lhs, uint rhs) {
-    return lhs / metal::select(rhs, 1u, rhs == 0u);
-}
-
-void unwarp_pixel(
+uint unwarp_pixel(
     metal::uint2 q,
+    uint i_1,
     metal::float4 w_1,
     metal::float4 support_1,
     metal::float4 depths_2,
     type_6 light_2,
     metal::texture2d<float, metal::access::sample> depth,
-    metal::texture2d<float, metal::access::write> output,
-    device FallbackCount& fallback_count,
-    device type_12& fallback_pixels,
-    constant _mslBufferSizes& _buffer_sizes
+    metal::texture2d<float, metal::access::write> output
 ) {
     uint clamped_lod_e3 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
     metal::float4 _e3 = depth.read(metal::min(metal::uint2(q), metal::uint2(depth.get_width(clamped_lod_e3), depth.get_height(clamped_lod_e3)) - 1), clamped_lod_e3);
     metal::float4 _e11 = lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(w_1, support_1, depths_2, light_2, _e3.x, DEPTH_BREAK, LIGHT_BREAK);
-    if (_e11.w == 0.0) {
-        uint _e18 = metal::atomic_fetch_add_explicit(&fallback_count.listed, 1u, metal::memory_order_relaxed);
-        fallback_pixels[metal::min(unsigned(_e18), (_buffer_sizes.size6 - 0 - 4) / 4)] = q.x | (q.y << 16u);
-        if (naga_mod(_e18, 64u) == 0u) {
-            uint g_2 = naga_div(_e18, 64u) + 1u;
-            uint _e38 = metal::atomic_fetch_max_explicit(&fallback_count.groups_x, metal::min(g_2, FALLBACK_ROW_GROUPS), metal::memory_order_relaxed);
-            uint _e47 = metal::atomic_fetch_max_explicit(&fallback_count.groups_y, naga_div((g_2 + FALLBACK_ROW_GROUPS) - 1u, FALLBACK_ROW_GROUPS), metal::memory_order_relaxed);
-            return;
-        } else {
-            return;
+    output.write(_e11, metal::uint2(q));
+    return (_e11.w == 0.0) ? (1u << i_1) : 0u;
+}
+
+uint naga_div(uint lhs, uint rhs) {
+    return lhs / metal::select(rhs, 1u, rhs == 0u);
+}
+
+void fallback_list_block(
+    metal::uint2 q0_,
+    uint side,
+    uint listed_1,
+    device FallbackCount& fallback_count,
+    device type_12& fallback_pixels,
+    constant _mslBufferSizes& _buffer_sizes
+) {
+    uint bits = {};
+    uint j_1 = 0u;
+    if (listed_1 != 0u) {
+        uint n_2 = metal::popcount(listed_1);
+        uint _e7 = metal::atomic_fetch_add_explicit(&fallback_count.listed, n_2, metal::memory_order_relaxed);
+        bits = listed_1;
+        uint2 loop_bound_1 = uint2(4294967295u);
+        bool loop_init_1 = true;
+        while(true) {
+            if (metal::all(loop_bound_1 == uint2(0u))) { break; }
+            loop_bound_1 -= uint2(loop_bound_1.y == 0u, 1u);
+            if (!loop_init_1) {
+                uint _e35 = j_1;
+                j_1 = _e35 + 1u;
+            }
+            loop_init_1 = false;
+            uint _e10 = j_1;
+            if (_e10 < n_2) {
+            } else {
+                break;
+            }
+            {
+                uint _e12 = bits;
+                uint i_2 = (((metal::ctz(_e12) + 1) % 33) - 1);
+                uint _e14 = bits;
+                uint _e15 = bits;
+                bits = _e14 & (_e15 - 1u);
+                metal::uint2 q_2 = q0_ + metal::uint2(naga_mod(i_2, side), naga_div(i_2, side));
+                uint _e26 = j_1;
+                fallback_pixels[metal::min(unsigned(_e7 + _e26), (_buffer_sizes.size6 - 0 - 4) / 4)] = q_2.x | (q_2.y << 16u);
+            }
         }
+        uint g_2 = naga_div((_e7 + n_2) - 1u, 64u) + 1u;
+        uint _e48 = metal::atomic_fetch_max_explicit(&fallback_count.groups_x, metal::min(g_2, FALLBACK_ROW_GROUPS), metal::memory_order_relaxed);
+        uint _e57 = metal::atomic_fetch_max_explicit(&fallback_count.groups_y, naga_div((g_2 + FALLBACK_ROW_GROUPS) - 1u, FALLBACK_ROW_GROUPS), metal::memory_order_relaxed);
+        return;
     } else {
-        output.write(_e11, metal::uint2(q));
         return;
     }
 }
@@ -550,7 +584,7 @@ metal::float3 raymarch_pixel(
     metal::texture2d<float, metal::access::sample> shadow_map
 ) {
     float sum_1 = 0.0;
-    uint j_1 = {};
+    uint j_2 = {};
     float t_1 = {};
     float w_2 = {};
     float l_2 = {};
@@ -560,8 +594,8 @@ metal::float3 raymarch_pixel(
     uint clamped_lod_e11 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
     metal::float4 _e11 = depth.read(metal::min(metal::uint2(metal::uint2(x_5, y_2)), metal::uint2(depth.get_width(clamped_lod_e11), depth.get_height(clamped_lod_e11)) - 1), clamped_lod_e11);
     float s = metal::min(metal::max(_e11.x, 0.0), m_2.eye.w) / metal::max(metal::dot(_e7, m_2.cam_forward.xyz), 0.000001);
-    uint n_2 = m_2.sizes.w;
-    float h_2 = s / static_cast<float>(n_2);
+    uint n_3 = m_2.sizes.w;
+    float h_2 = s / static_cast<float>(n_3);
     uint mx = m_2.interleave.x;
     uint my = m_2.interleave.y;
     uint stride = mx * my;
@@ -569,29 +603,29 @@ metal::float3 raymarch_pixel(
     float _e37 = pixel_jitterX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(x_5, y_2);
     float u = (m_2.interleave.z != 0u) ? _e37 : 0.5;
     ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX _e44 = raymarch_shadow_viewX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m_2);
-    EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX _e48 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2, _e7, m_2.light_pos.xyz, 0.0, s, n_2);
-    j_1 = pixel_class;
-    uint2 loop_bound_1 = uint2(4294967295u);
-    bool loop_init_1 = true;
+    EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX _e48 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2, _e7, m_2.light_pos.xyz, 0.0, s, n_3);
+    j_2 = pixel_class;
+    uint2 loop_bound_2 = uint2(4294967295u);
+    bool loop_init_2 = true;
     while(true) {
-        if (metal::all(loop_bound_1 == uint2(0u))) { break; }
-        loop_bound_1 -= uint2(loop_bound_1.y == 0u, 1u);
-        if (!loop_init_1) {
-            uint _e101 = j_1;
-            j_1 = _e101 + stride;
+        if (metal::all(loop_bound_2 == uint2(0u))) { break; }
+        loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
+        if (!loop_init_2) {
+            uint _e101 = j_2;
+            j_2 = _e101 + stride;
         }
-        loop_init_1 = false;
-        uint _e50 = j_1;
-        if (_e50 < n_2) {
+        loop_init_2 = false;
+        uint _e50 = j_2;
+        if (_e50 < n_3) {
         } else {
             break;
         }
         {
-            uint _e52 = j_1;
+            uint _e52 = j_2;
             t_1 = (static_cast<float>(_e52) + u) * h_2;
             w_2 = h_2;
             if (false) {
-                uint _e59 = j_1;
+                uint _e59 = j_2;
                 metal::float2 _e62 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e48, static_cast<float>(_e59) + u);
                 t_1 = _e62.x;
                 w_2 = _e62.y;
@@ -606,8 +640,8 @@ metal::float3 raymarch_pixel(
                 sum_1 = _e71 + ((_e69 * _e72) * _e84);
             } else {
                 float _e87 = sum_1;
-                uint _e90 = j_1;
-                uint _e93 = j_1;
+                uint _e90 = j_2;
+                uint _e93 = j_2;
                 float _e98 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(m_2.medium.x, static_cast<float>(_e90) * h_2, static_cast<float>(_e93 + 1u) * h_2);
                 sum_1 = _e87 + (_e69 * _e98);
             }
@@ -641,14 +675,15 @@ kernel void raymarch_unwarp(
     metal::float4 depths = metal::float4(0.0, 0.0, 0.0, 0.0);
     type_6 light = {};
     uint j = 0u;
+    uint listed = 0u;
     uint i = 0u;
     bool local_1 = {};
     uint _e6 = frame.sizes.x;
     uint _e10 = frame.sizes.y;
     metal::uint2 screen = metal::uint2(_e6, _e10);
-    metal::uint2 q0_ = id.xy * UNWARP_BLOCK;
-    if (!((q0_.x >= screen.x))) {
-        local = q0_.y >= screen.y;
+    metal::uint2 q0_1 = id.xy * UNWARP_BLOCK;
+    if (!((q0_1.x >= screen.x))) {
+        local = q0_1.y >= screen.y;
     } else {
         local = true;
     }
@@ -661,23 +696,23 @@ kernel void raymarch_unwarp(
     uint clamped_lod_e38 = metal::min(uint(0), epipolar_samples.get_num_mip_levels() - 1);
     metal::float4 angles = epipolar_samples.read(metal::min(metal::uint2(metal::uint2(1u, 256u)), metal::uint2(epipolar_samples.get_width(clamped_lod_e38), epipolar_samples.get_height(clamped_lod_e38)) - 1), clamped_lod_e38);
     EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX lines = EpipolarLayoutX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX {head.xy, head.zw, angles.x, angles.y, naga_f2u32(angles.z)};
-    metal::float2 centre = static_cast<metal::float2>(q0_) + metal::float2(1.0);
+    metal::float2 centre = static_cast<metal::float2>(q0_1) + metal::float2(1.0);
     EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e51 = epipolar_block_slicesX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, centre, SLICES);
     uint clamped_lod_e58 = metal::min(uint(0), epipolar_samples.get_num_mip_levels() - 1);
     metal::float4 line_lo_1 = epipolar_samples.read(metal::min(metal::uint2(metal::uint2(SLICE_SAMPLES, _e51.slices.x)), metal::uint2(epipolar_samples.get_width(clamped_lod_e58), epipolar_samples.get_height(clamped_lod_e58)) - 1), clamped_lod_e58);
     uint clamped_lod_e65 = metal::min(uint(0), epipolar_samples.get_num_mip_levels() - 1);
     metal::float4 line_hi_1 = epipolar_samples.read(metal::min(metal::uint2(metal::uint2(SLICE_SAMPLES, _e51.slices.y)), metal::uint2(epipolar_samples.get_width(clamped_lod_e65), epipolar_samples.get_height(clamped_lod_e65)) - 1), clamped_lod_e65);
     EpipolarBlockX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e67 = epipolar_block_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(lines, centre, _e51, line_lo_1, line_hi_1, SLICE_SAMPLES);
-    uint2 loop_bound_2 = uint2(4294967295u);
-    bool loop_init_2 = true;
+    uint2 loop_bound_3 = uint2(4294967295u);
+    bool loop_init_3 = true;
     while(true) {
-        if (metal::all(loop_bound_2 == uint2(0u))) { break; }
-        loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
-        if (!loop_init_2) {
+        if (metal::all(loop_bound_3 == uint2(0u))) { break; }
+        loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
+        if (!loop_init_3) {
             uint _e99 = j;
             j = _e99 + 1u;
         }
-        loop_init_2 = false;
+        loop_init_3 = false;
         uint _e69 = j;
         if (_e69 < 4u) {
         } else {
@@ -696,16 +731,16 @@ kernel void raymarch_unwarp(
         }
     }
     metal::float4 _e104 = epipolar_block_weightsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e67, metal::float2(0.0, 0.0));
-    uint2 loop_bound_3 = uint2(4294967295u);
-    bool loop_init_3 = true;
+    uint2 loop_bound_4 = uint2(4294967295u);
+    bool loop_init_4 = true;
     while(true) {
-        if (metal::all(loop_bound_3 == uint2(0u))) { break; }
-        loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
-        if (!loop_init_3) {
-            uint _e137 = i;
-            i = _e137 + 1u;
+        if (metal::all(loop_bound_4 == uint2(0u))) { break; }
+        loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
+        if (!loop_init_4) {
+            uint _e142 = i;
+            i = _e142 + 1u;
         }
-        loop_init_3 = false;
+        loop_init_4 = false;
         uint _e106 = i;
         if (_e106 < 4u) {
         } else {
@@ -714,20 +749,25 @@ kernel void raymarch_unwarp(
         {
             uint _e109 = i;
             uint _e112 = i;
-            metal::uint2 q_2 = q0_ + metal::uint2(naga_mod(_e109, UNWARP_BLOCK), naga_div(_e112, UNWARP_BLOCK));
-            if (q_2.x < screen.x) {
-                local_1 = q_2.y < screen.y;
+            metal::uint2 q_3 = q0_1 + metal::uint2(naga_mod(_e109, UNWARP_BLOCK), naga_div(_e112, UNWARP_BLOCK));
+            if (q_3.x < screen.x) {
+                local_1 = q_3.y < screen.y;
             } else {
                 local_1 = false;
             }
             bool _e126 = local_1;
             if (_e126) {
-                metal::float4 _e133 = epipolar_block_weightsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e67, (static_cast<metal::float2>(q_2) + metal::float2(0.5, 0.5)) - centre);
-                metal::float4 _e134 = depths;
-                type_6 _e135 = light;
-                unwarp_pixel(q_2, _e133, _e104, _e134, _e135, depth, output, fallback_count, fallback_pixels, _buffer_sizes);
+                metal::float4 _e133 = epipolar_block_weightsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(_e67, (static_cast<metal::float2>(q_3) + metal::float2(0.5, 0.5)) - centre);
+                uint _e135 = listed;
+                uint _e136 = i;
+                metal::float4 _e137 = depths;
+                type_6 _e138 = light;
+                uint _e139 = unwarp_pixel(q_3, _e136, _e133, _e104, _e137, _e138, depth, output);
+                listed = _e135 | _e139;
             }
         }
     }
+    uint _e144 = listed;
+    fallback_list_block(q0_1, UNWARP_BLOCK, _e144, fallback_count, fallback_pixels, _buffer_sizes);
     return;
 }

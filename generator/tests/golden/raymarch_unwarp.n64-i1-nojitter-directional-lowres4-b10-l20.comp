@@ -325,23 +325,49 @@ void fallback_list_reset() {
     return;
 }
 
-void unwarp_pixel(uvec2 q, vec4 w_1, vec4 support_1, vec4 depths_2, vec3 light_2[4]) {
+uint unwarp_pixel(uvec2 q, uint i_2, vec4 w_1, vec4 support_1, vec4 depths_2, vec3 light_2[4]) {
     int _e3_clamped_lod = clamp(0, 0, textureQueryLevels(_group_0_binding_1_cs) - 1);
     vec4 _e3 = texelFetch(_group_0_binding_1_cs, clamp(ivec2(q), ivec2(0), textureSize(_group_0_binding_1_cs, _e3_clamped_lod) - ivec2(1)), _e3_clamped_lod);
     vec4 _e11 = lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(w_1, support_1, depths_2, light_2, _e3.x, DEPTH_BREAK, LIGHT_BREAK);
-    if ((_e11.w == 0.0)) {
-        uint _e18 = atomicAdd(_group_0_binding_5_cs.listed, 1u);
-        _group_0_binding_6_cs[_e18] = (q.x | (q.y << 16u));
-        if (((_e18 % 64u) == 0u)) {
-            uint g_1 = ((_e18 / 64u) + 1u);
-            uint _e38 = atomicMax(_group_0_binding_5_cs.groups_x, min(g_1, FALLBACK_ROW_GROUPS));
-            uint _e47 = atomicMax(_group_0_binding_5_cs.groups_y, (((g_1 + FALLBACK_ROW_GROUPS) - 1u) / FALLBACK_ROW_GROUPS));
-            return;
-        } else {
-            return;
+    imageStore(_group_0_binding_3_cs, ivec2(q), _e11);
+    return ((_e11.w == 0.0) ? (1u << i_2) : 0u);
+}
+
+void fallback_list_block(uvec2 q0_, uint side, uint listed_1) {
+    uint bits = 0u;
+    uint j_1 = 0u;
+    if ((listed_1 != 0u)) {
+        uint n_2 = uint(bitCount(listed_1));
+        uint _e7 = atomicAdd(_group_0_binding_5_cs.listed, n_2);
+        bits = listed_1;
+        bool loop_init_1 = true;
+        while(true) {
+            if (!loop_init_1) {
+                uint _e35 = j_1;
+                j_1 = (_e35 + 1u);
+            }
+            loop_init_1 = false;
+            uint _e10 = j_1;
+            if ((_e10 < n_2)) {
+            } else {
+                break;
+            }
+            {
+                uint _e12 = bits;
+                uint i_3 = uint(findLSB(_e12));
+                uint _e14 = bits;
+                uint _e15 = bits;
+                bits = (_e14 & (_e15 - 1u));
+                uvec2 q_2 = (q0_ + uvec2((i_3 % side), (i_3 / side)));
+                uint _e26 = j_1;
+                _group_0_binding_6_cs[(_e7 + _e26)] = (q_2.x | (q_2.y << 16u));
+            }
         }
+        uint g_1 = ((((_e7 + n_2) - 1u) / 64u) + 1u);
+        uint _e48 = atomicMax(_group_0_binding_5_cs.groups_x, min(g_1, FALLBACK_ROW_GROUPS));
+        uint _e57 = atomicMax(_group_0_binding_5_cs.groups_y, (((g_1 + FALLBACK_ROW_GROUPS) - 1u) / FALLBACK_ROW_GROUPS));
+        return;
     } else {
-        imageStore(_group_0_binding_3_cs, ivec2(q), _e11);
         return;
     }
 }
@@ -352,14 +378,15 @@ void main() {
     vec4 depths = vec4(0.0, 0.0, 0.0, 0.0);
     vec3 light[4] = vec3[4](vec3(0.0), vec3(0.0), vec3(0.0), vec3(0.0));
     uint j = 0u;
+    uint listed = 0u;
     uint i = 0u;
     bool local_1 = false;
     uint _e6 = _group_0_binding_0_cs.sizes.x;
     uint _e10 = _group_0_binding_0_cs.sizes.y;
     uvec2 screen_3 = uvec2(_e6, _e10);
-    uvec2 q0_ = (id.xy * SCALE);
-    if (!((q0_.x >= screen_3.x))) {
-        local = (q0_.y >= screen_3.y);
+    uvec2 q0_1 = (id.xy * SCALE);
+    if (!((q0_1.x >= screen_3.x))) {
+        local = (q0_1.y >= screen_3.y);
     } else {
         local = true;
     }
@@ -367,14 +394,14 @@ void main() {
     if (_e26) {
         return;
     }
-    LowresTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e28 = lowres_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(q0_, screen_3, SCALE);
-    bool loop_init_1 = true;
+    LowresTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e28 = lowres_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(q0_1, screen_3, SCALE);
+    bool loop_init_2 = true;
     while(true) {
-        if (!loop_init_1) {
+        if (!loop_init_2) {
             uint _e56 = j;
             j = (_e56 + 1u);
         }
-        loop_init_1 = false;
+        loop_init_2 = false;
         uint _e30 = j;
         if ((_e30 < 4u)) {
         } else {
@@ -391,13 +418,13 @@ void main() {
             light[_e52] = v_7.xyz;
         }
     }
-    bool loop_init_2 = true;
+    bool loop_init_3 = true;
     while(true) {
-        if (!loop_init_2) {
-            uint _e86 = i;
-            i = (_e86 + 1u);
+        if (!loop_init_3) {
+            uint _e91 = i;
+            i = (_e91 + 1u);
         }
-        loop_init_2 = false;
+        loop_init_3 = false;
         uint _e59 = i;
         if ((_e59 < 16u)) {
         } else {
@@ -406,22 +433,27 @@ void main() {
         {
             uint _e62 = i;
             uint _e65 = i;
-            uvec2 q_2 = (q0_ + uvec2((_e62 % SCALE), (_e65 / SCALE)));
-            if ((q_2.x < screen_3.x)) {
-                local_1 = (q_2.y < screen_3.y);
+            uvec2 q_3 = (q0_1 + uvec2((_e62 % SCALE), (_e65 / SCALE)));
+            if ((q_3.x < screen_3.x)) {
+                local_1 = (q_3.y < screen_3.y);
             } else {
                 local_1 = false;
             }
             bool _e79 = local_1;
             if (_e79) {
-                LowresTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e81 = lowres_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(q_2, screen_3, SCALE);
+                LowresTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e81 = lowres_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(q_3, screen_3, SCALE);
                 vec4 w_3 = _e81.w;
-                vec4 _e83 = depths;
-                vec3 _e84[4] = light;
-                unwarp_pixel(q_2, w_3, w_3, _e83, _e84);
+                uint _e84 = listed;
+                uint _e85 = i;
+                vec4 _e86 = depths;
+                vec3 _e87[4] = light;
+                uint _e88 = unwarp_pixel(q_3, _e85, w_3, w_3, _e86, _e87);
+                listed = (_e84 | _e88);
             }
         }
     }
+    uint _e93 = listed;
+    fallback_list_block(q0_1, SCALE, _e93);
     return;
 }
 

@@ -379,6 +379,14 @@ void fallback_list_reset()
     return;
 }
 
+uint unwarp_pixel(uint2 q, uint i_2, float4 w_1, float4 support_1, float4 depths_2, float3 light_2[4])
+{
+    float4 _e3 = depth.Load(int3(q, int(0)));
+    const float4 _e11 = lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(w_1, support_1, depths_2, light_2, _e3.x, DEPTH_BREAK, LIGHT_BREAK);
+    output[q] = _e11;
+    return ((_e11.w == 0.0) ? (1u << i_2) : 0u);
+}
+
 uint naga_mod(uint lhs, uint rhs) {
     return lhs % (rhs == 0u ? 1u : rhs);
 }
@@ -387,23 +395,46 @@ uint naga_div(uint lhs, uint rhs) {
     return lhs / (rhs == 0u ? 1u : rhs);
 }
 
-void unwarp_pixel(uint2 q, float4 w_1, float4 support_1, float4 depths_2, float3 light_2[4])
+void fallback_list_block(uint2 q0_, uint side, uint listed_1)
 {
-    float4 _e3 = depth.Load(int3(q, int(0)));
-    const float4 _e11 = lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(w_1, support_1, depths_2, light_2, _e3.x, DEPTH_BREAK, LIGHT_BREAK);
-    if ((_e11.w == 0.0)) {
-        uint _e18; fallback_count.InterlockedAdd(0, 1u, _e18);
-        fallback_pixels.Store(_e18*4, asuint((q.x | (q.y << 16u))));
-        if ((naga_mod(_e18, 64u) == 0u)) {
-            uint g_1 = (naga_div(_e18, 64u) + 1u);
-            uint _e38; fallback_count.InterlockedMax(4, min(g_1, FALLBACK_ROW_GROUPS), _e38);
-            uint _e47; fallback_count.InterlockedMax(8, naga_div(((g_1 + FALLBACK_ROW_GROUPS) - 1u), FALLBACK_ROW_GROUPS), _e47);
-            return;
-        } else {
-            return;
+    uint bits = (uint)0;
+    uint j_1 = 0u;
+
+    if ((listed_1 != 0u)) {
+        uint n_2 = countbits(listed_1);
+        uint _e7; fallback_count.InterlockedAdd(0, n_2, _e7);
+        bits = listed_1;
+        uint2 loop_bound_1 = uint2(4294967295u, 4294967295u);
+        bool loop_init_1 = true;
+        while(true) {
+            if (all(loop_bound_1 == uint2(0u, 0u))) { break; }
+            loop_bound_1 -= uint2(loop_bound_1.y == 0u, 1u);
+            if (!loop_init_1) {
+                uint _e35 = j_1;
+                j_1 = (_e35 + 1u);
+            }
+            loop_init_1 = false;
+            uint _e10 = j_1;
+            if ((_e10 < n_2)) {
+            } else {
+                break;
+            }
+            {
+                uint _e12 = bits;
+                uint i_3 = firstbitlow(_e12);
+                uint _e14 = bits;
+                uint _e15 = bits;
+                bits = (_e14 & (_e15 - 1u));
+                uint2 q_2 = (q0_ + uint2(naga_mod(i_3, side), naga_div(i_3, side)));
+                uint _e26 = j_1;
+                fallback_pixels.Store((_e7 + _e26)*4, asuint((q_2.x | (q_2.y << 16u))));
+            }
         }
+        uint g_1 = (naga_div(((_e7 + n_2) - 1u), 64u) + 1u);
+        uint _e48; fallback_count.InterlockedMax(4, min(g_1, FALLBACK_ROW_GROUPS), _e48);
+        uint _e57; fallback_count.InterlockedMax(8, naga_div(((g_1 + FALLBACK_ROW_GROUPS) - 1u), FALLBACK_ROW_GROUPS), _e57);
+        return;
     } else {
-        output[q] = _e11;
         return;
     }
 }
@@ -415,15 +446,16 @@ void raymarch_unwarp(uint3 id : SV_DispatchThreadID)
     float4 depths = float4(0.0, 0.0, 0.0, 0.0);
     float3 light[4] = (float3[4])0;
     uint j = 0u;
+    uint listed = 0u;
     uint i = 0u;
     bool local_1 = (bool)0;
 
     uint _e6 = frame.sizes.x;
     uint _e10 = frame.sizes.y;
     uint2 screen_3 = uint2(_e6, _e10);
-    uint2 q0_ = (id.xy * SCALE);
-    if (!((q0_.x >= screen_3.x))) {
-        local = (q0_.y >= screen_3.y);
+    uint2 q0_1 = (id.xy * SCALE);
+    if (!((q0_1.x >= screen_3.x))) {
+        local = (q0_1.y >= screen_3.y);
     } else {
         local = true;
     }
@@ -431,17 +463,17 @@ void raymarch_unwarp(uint3 id : SV_DispatchThreadID)
     if (_e26) {
         return;
     }
-    const LowresTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e28 = lowres_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(q0_, screen_3, SCALE);
-    uint2 loop_bound_1 = uint2(4294967295u, 4294967295u);
-    bool loop_init_1 = true;
+    const LowresTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e28 = lowres_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(q0_1, screen_3, SCALE);
+    uint2 loop_bound_2 = uint2(4294967295u, 4294967295u);
+    bool loop_init_2 = true;
     while(true) {
-        if (all(loop_bound_1 == uint2(0u, 0u))) { break; }
-        loop_bound_1 -= uint2(loop_bound_1.y == 0u, 1u);
-        if (!loop_init_1) {
+        if (all(loop_bound_2 == uint2(0u, 0u))) { break; }
+        loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
+        if (!loop_init_2) {
             uint _e56 = j;
             j = (_e56 + 1u);
         }
-        loop_init_1 = false;
+        loop_init_2 = false;
         uint _e30 = j;
         if ((_e30 < 4u)) {
         } else {
@@ -457,16 +489,16 @@ void raymarch_unwarp(uint3 id : SV_DispatchThreadID)
             light[min(uint(_e52), 3u)] = v_7.xyz;
         }
     }
-    uint2 loop_bound_2 = uint2(4294967295u, 4294967295u);
-    bool loop_init_2 = true;
+    uint2 loop_bound_3 = uint2(4294967295u, 4294967295u);
+    bool loop_init_3 = true;
     while(true) {
-        if (all(loop_bound_2 == uint2(0u, 0u))) { break; }
-        loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
-        if (!loop_init_2) {
-            uint _e86 = i;
-            i = (_e86 + 1u);
+        if (all(loop_bound_3 == uint2(0u, 0u))) { break; }
+        loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
+        if (!loop_init_3) {
+            uint _e91 = i;
+            i = (_e91 + 1u);
         }
-        loop_init_2 = false;
+        loop_init_3 = false;
         uint _e59 = i;
         if ((_e59 < 16u)) {
         } else {
@@ -475,21 +507,26 @@ void raymarch_unwarp(uint3 id : SV_DispatchThreadID)
         {
             uint _e62 = i;
             uint _e65 = i;
-            uint2 q_2 = (q0_ + uint2(naga_mod(_e62, SCALE), naga_div(_e65, SCALE)));
-            if ((q_2.x < screen_3.x)) {
-                local_1 = (q_2.y < screen_3.y);
+            uint2 q_3 = (q0_1 + uint2(naga_mod(_e62, SCALE), naga_div(_e65, SCALE)));
+            if ((q_3.x < screen_3.x)) {
+                local_1 = (q_3.y < screen_3.y);
             } else {
                 local_1 = false;
             }
             bool _e79 = local_1;
             if (_e79) {
-                const LowresTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e81 = lowres_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(q_2, screen_3, SCALE);
+                const LowresTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e81 = lowres_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(q_3, screen_3, SCALE);
                 float4 w_3 = _e81.w;
-                float4 _e83 = depths;
-                float3 _e84[4] = light;
-                unwarp_pixel(q_2, w_3, w_3, _e83, _e84);
+                uint _e84 = listed;
+                uint _e85 = i;
+                float4 _e86 = depths;
+                float3 _e87[4] = light;
+                const uint _e88 = unwarp_pixel(q_3, _e85, w_3, w_3, _e86, _e87);
+                listed = (_e84 | _e88);
             }
         }
     }
+    uint _e93 = listed;
+    fallback_list_block(q0_1, SCALE, _e93);
     return;
 }

@@ -422,6 +422,23 @@ void fallback_list_reset(
     return;
 }
 
+uint unwarp_pixel(
+    metal::uint2 q,
+    uint i_2,
+    metal::float4 w_1,
+    metal::float4 support_1,
+    metal::float4 depths_2,
+    type_6 light_2,
+    metal::texture2d<float, metal::access::sample> depth,
+    metal::texture2d<float, metal::access::write> output
+) {
+    uint clamped_lod_e3 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
+    metal::float4 _e3 = depth.read(metal::min(metal::uint2(q), metal::uint2(depth.get_width(clamped_lod_e3), depth.get_height(clamped_lod_e3)) - 1), clamped_lod_e3);
+    metal::float4 _e11 = lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(w_1, support_1, depths_2, light_2, _e3.x, DEPTH_BREAK, LIGHT_BREAK);
+    output.write(_e11, metal::uint2(q));
+    return (_e11.w == 0.0) ? (1u << i_2) : 0u;
+}
+
 uint naga_mod(uint lhs, uint rhs) {
     return lhs % metal::select(rhs, 1u, rhs == 0u);
 }
@@ -430,34 +447,51 @@ uint naga_div(uint lhs, uint rhs) {
     return lhs / metal::select(rhs, 1u, rhs == 0u);
 }
 
-void unwarp_pixel(
-    metal::uint2 q,
-    metal::float4 w_1,
-    metal::float4 support_1,
-    metal::float4 depths_2,
-    type_6 light_2,
-    metal::texture2d<float, metal::access::sample> depth,
-    metal::texture2d<float, metal::access::write> output,
+void fallback_list_block(
+    metal::uint2 q0_,
+    uint side,
+    uint listed_1,
     device FallbackCount& fallback_count,
     device type_12& fallback_pixels,
     constant _mslBufferSizes& _buffer_sizes
 ) {
-    uint clamped_lod_e3 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
-    metal::float4 _e3 = depth.read(metal::min(metal::uint2(q), metal::uint2(depth.get_width(clamped_lod_e3), depth.get_height(clamped_lod_e3)) - 1), clamped_lod_e3);
-    metal::float4 _e11 = lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(w_1, support_1, depths_2, light_2, _e3.x, DEPTH_BREAK, LIGHT_BREAK);
-    if (_e11.w == 0.0) {
-        uint _e18 = metal::atomic_fetch_add_explicit(&fallback_count.listed, 1u, metal::memory_order_relaxed);
-        fallback_pixels[metal::min(unsigned(_e18), (_buffer_sizes.size6 - 0 - 4) / 4)] = q.x | (q.y << 16u);
-        if (naga_mod(_e18, 64u) == 0u) {
-            uint g_1 = naga_div(_e18, 64u) + 1u;
-            uint _e38 = metal::atomic_fetch_max_explicit(&fallback_count.groups_x, metal::min(g_1, FALLBACK_ROW_GROUPS), metal::memory_order_relaxed);
-            uint _e47 = metal::atomic_fetch_max_explicit(&fallback_count.groups_y, naga_div((g_1 + FALLBACK_ROW_GROUPS) - 1u, FALLBACK_ROW_GROUPS), metal::memory_order_relaxed);
-            return;
-        } else {
-            return;
+    uint bits = {};
+    uint j_1 = 0u;
+    if (listed_1 != 0u) {
+        uint n_2 = metal::popcount(listed_1);
+        uint _e7 = metal::atomic_fetch_add_explicit(&fallback_count.listed, n_2, metal::memory_order_relaxed);
+        bits = listed_1;
+        uint2 loop_bound_1 = uint2(4294967295u);
+        bool loop_init_1 = true;
+        while(true) {
+            if (metal::all(loop_bound_1 == uint2(0u))) { break; }
+            loop_bound_1 -= uint2(loop_bound_1.y == 0u, 1u);
+            if (!loop_init_1) {
+                uint _e35 = j_1;
+                j_1 = _e35 + 1u;
+            }
+            loop_init_1 = false;
+            uint _e10 = j_1;
+            if (_e10 < n_2) {
+            } else {
+                break;
+            }
+            {
+                uint _e12 = bits;
+                uint i_3 = (((metal::ctz(_e12) + 1) % 33) - 1);
+                uint _e14 = bits;
+                uint _e15 = bits;
+                bits = _e14 & (_e15 - 1u);
+                metal::uint2 q_2 = q0_ + metal::uint2(naga_mod(i_3, side), naga_div(i_3, side));
+                uint _e26 = j_1;
+                fallback_pixels[metal::min(unsigned(_e7 + _e26), (_buffer_sizes.size6 - 0 - 4) / 4)] = q_2.x | (q_2.y << 16u);
+            }
         }
+        uint g_1 = naga_div((_e7 + n_2) - 1u, 64u) + 1u;
+        uint _e48 = metal::atomic_fetch_max_explicit(&fallback_count.groups_x, metal::min(g_1, FALLBACK_ROW_GROUPS), metal::memory_order_relaxed);
+        uint _e57 = metal::atomic_fetch_max_explicit(&fallback_count.groups_y, naga_div((g_1 + FALLBACK_ROW_GROUPS) - 1u, FALLBACK_ROW_GROUPS), metal::memory_order_relaxed);
+        return;
     } else {
-        output.write(_e11, metal::uint2(q));
         return;
     }
 }
@@ -470,7 +504,7 @@ metal::float3 raymarch_pixel(
     metal::texture2d<float, metal::access::sample> shadow_map
 ) {
     float sum_1 = 0.0;
-    uint j_1 = {};
+    uint j_2 = {};
     float t_2 = {};
     float w_2 = {};
     float l = {};
@@ -480,8 +514,8 @@ metal::float3 raymarch_pixel(
     uint clamped_lod_e11 = metal::min(uint(0), depth.get_num_mip_levels() - 1);
     metal::float4 _e11 = depth.read(metal::min(metal::uint2(metal::uint2(x_3, y_2)), metal::uint2(depth.get_width(clamped_lod_e11), depth.get_height(clamped_lod_e11)) - 1), clamped_lod_e11);
     float s = metal::min(metal::max(_e11.x, 0.0), m_2.eye.w) / metal::max(metal::dot(_e7, m_2.cam_forward.xyz), 0.000001);
-    uint n_2 = m_2.sizes.w;
-    float h_2 = s / static_cast<float>(n_2);
+    uint n_3 = m_2.sizes.w;
+    float h_2 = s / static_cast<float>(n_3);
     uint mx = m_2.interleave.x;
     uint my = m_2.interleave.y;
     uint stride = mx * my;
@@ -489,29 +523,29 @@ metal::float3 raymarch_pixel(
     float _e37 = pixel_jitterX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(x_3, y_2);
     float u = (m_2.interleave.z != 0u) ? _e37 : 0.5;
     ShadowMapViewX_naga_oil_mod_XONRWC5DUMVZDUOTTNBQWI33XX _e44 = raymarch_shadow_viewX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m_2);
-    EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX _e48 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2, _e7, m_2.light_pos.xyz, 0.0, s, n_2);
-    j_1 = pixel_class;
-    uint2 loop_bound_1 = uint2(4294967295u);
-    bool loop_init_1 = true;
+    EquiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX _e48 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2, _e7, m_2.light_pos.xyz, 0.0, s, n_3);
+    j_2 = pixel_class;
+    uint2 loop_bound_2 = uint2(4294967295u);
+    bool loop_init_2 = true;
     while(true) {
-        if (metal::all(loop_bound_1 == uint2(0u))) { break; }
-        loop_bound_1 -= uint2(loop_bound_1.y == 0u, 1u);
-        if (!loop_init_1) {
-            uint _e101 = j_1;
-            j_1 = _e101 + stride;
+        if (metal::all(loop_bound_2 == uint2(0u))) { break; }
+        loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
+        if (!loop_init_2) {
+            uint _e101 = j_2;
+            j_2 = _e101 + stride;
         }
-        loop_init_1 = false;
-        uint _e50 = j_1;
-        if (_e50 < n_2) {
+        loop_init_2 = false;
+        uint _e50 = j_2;
+        if (_e50 < n_3) {
         } else {
             break;
         }
         {
-            uint _e52 = j_1;
+            uint _e52 = j_2;
             t_2 = (static_cast<float>(_e52) + u) * h_2;
             w_2 = h_2;
             if (false) {
-                uint _e59 = j_1;
+                uint _e59 = j_2;
                 metal::float2 _e62 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e48, static_cast<float>(_e59) + u);
                 t_2 = _e62.x;
                 w_2 = _e62.y;
@@ -526,8 +560,8 @@ metal::float3 raymarch_pixel(
                 sum_1 = _e71 + ((_e69 * _e72) * _e84);
             } else {
                 float _e87 = sum_1;
-                uint _e90 = j_1;
-                uint _e93 = j_1;
+                uint _e90 = j_2;
+                uint _e93 = j_2;
                 float _e98 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(m_2.medium.x, static_cast<float>(_e90) * h_2, static_cast<float>(_e93 + 1u) * h_2);
                 sum_1 = _e87 + (_e69 * _e98);
             }
@@ -561,14 +595,15 @@ kernel void raymarch_unwarp(
     metal::float4 depths = metal::float4(0.0, 0.0, 0.0, 0.0);
     type_6 light = {};
     uint j = 0u;
+    uint listed = 0u;
     uint i = 0u;
     bool local_1 = {};
     uint _e6 = frame.sizes.x;
     uint _e10 = frame.sizes.y;
     metal::uint2 screen_3 = metal::uint2(_e6, _e10);
-    metal::uint2 q0_ = id.xy * SCALE;
-    if (!((q0_.x >= screen_3.x))) {
-        local = q0_.y >= screen_3.y;
+    metal::uint2 q0_1 = id.xy * SCALE;
+    if (!((q0_1.x >= screen_3.x))) {
+        local = q0_1.y >= screen_3.y;
     } else {
         local = true;
     }
@@ -576,17 +611,17 @@ kernel void raymarch_unwarp(
     if (_e26) {
         return;
     }
-    LowresTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e28 = lowres_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(q0_, screen_3, SCALE);
-    uint2 loop_bound_2 = uint2(4294967295u);
-    bool loop_init_2 = true;
+    LowresTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e28 = lowres_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(q0_1, screen_3, SCALE);
+    uint2 loop_bound_3 = uint2(4294967295u);
+    bool loop_init_3 = true;
     while(true) {
-        if (metal::all(loop_bound_2 == uint2(0u))) { break; }
-        loop_bound_2 -= uint2(loop_bound_2.y == 0u, 1u);
-        if (!loop_init_2) {
+        if (metal::all(loop_bound_3 == uint2(0u))) { break; }
+        loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
+        if (!loop_init_3) {
             uint _e56 = j;
             j = _e56 + 1u;
         }
-        loop_init_2 = false;
+        loop_init_3 = false;
         uint _e30 = j;
         if (_e30 < 4u) {
         } else {
@@ -603,16 +638,16 @@ kernel void raymarch_unwarp(
             light.inner[metal::min(unsigned(_e52), 3u)] = v_7.xyz;
         }
     }
-    uint2 loop_bound_3 = uint2(4294967295u);
-    bool loop_init_3 = true;
+    uint2 loop_bound_4 = uint2(4294967295u);
+    bool loop_init_4 = true;
     while(true) {
-        if (metal::all(loop_bound_3 == uint2(0u))) { break; }
-        loop_bound_3 -= uint2(loop_bound_3.y == 0u, 1u);
-        if (!loop_init_3) {
-            uint _e86 = i;
-            i = _e86 + 1u;
+        if (metal::all(loop_bound_4 == uint2(0u))) { break; }
+        loop_bound_4 -= uint2(loop_bound_4.y == 0u, 1u);
+        if (!loop_init_4) {
+            uint _e91 = i;
+            i = _e91 + 1u;
         }
-        loop_init_3 = false;
+        loop_init_4 = false;
         uint _e59 = i;
         if (_e59 < 16u) {
         } else {
@@ -621,21 +656,26 @@ kernel void raymarch_unwarp(
         {
             uint _e62 = i;
             uint _e65 = i;
-            metal::uint2 q_2 = q0_ + metal::uint2(naga_mod(_e62, SCALE), naga_div(_e65, SCALE));
-            if (q_2.x < screen_3.x) {
-                local_1 = q_2.y < screen_3.y;
+            metal::uint2 q_3 = q0_1 + metal::uint2(naga_mod(_e62, SCALE), naga_div(_e65, SCALE));
+            if (q_3.x < screen_3.x) {
+                local_1 = q_3.y < screen_3.y;
             } else {
                 local_1 = false;
             }
             bool _e79 = local_1;
             if (_e79) {
-                LowresTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e81 = lowres_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(q_2, screen_3, SCALE);
+                LowresTapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX _e81 = lowres_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(q_3, screen_3, SCALE);
                 metal::float4 w_3 = _e81.w;
-                metal::float4 _e83 = depths;
-                type_6 _e84 = light;
-                unwarp_pixel(q_2, w_3, w_3, _e83, _e84, depth, output, fallback_count, fallback_pixels, _buffer_sizes);
+                uint _e84 = listed;
+                uint _e85 = i;
+                metal::float4 _e86 = depths;
+                type_6 _e87 = light;
+                uint _e88 = unwarp_pixel(q_3, _e85, w_3, w_3, _e86, _e87, depth, output);
+                listed = _e84 | _e88;
             }
         }
     }
+    uint _e93 = listed;
+    fallback_list_block(q0_1, SCALE, _e93, fallback_count, fallback_pixels, _buffer_sizes);
     return;
 }

@@ -328,29 +328,54 @@ fn fallback_list_reset() {
     return;
 }
 
-fn unwarp_pixel(q: vec2<u32>, w_1: vec4<f32>, support_1: vec4<f32>, depths_2: vec4<f32>, light_2: array<vec3<f32>, 4>) {
+fn unwarp_pixel(q: vec2<u32>, i_2: u32, w_1: vec4<f32>, support_1: vec4<f32>, depths_2: vec4<f32>, light_2: array<vec3<f32>, 4>) -> u32 {
     let _e3 = textureLoad(depth, q, 0i);
     let _e11 = lowres_blendX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(w_1, support_1, depths_2, light_2, _e3.x, DEPTH_BREAK, LIGHT_BREAK);
-    if (_e11.w == 0f) {
-        let _e18 = atomicAdd((&fallback_count.listed), 1u);
-        fallback_pixels[_e18] = (q.x | (q.y << 16u));
-        if ((_e18 % 64u) == 0u) {
-            let g_1 = ((_e18 / 64u) + 1u);
-            let _e38 = atomicMax((&fallback_count.groups_x), min(g_1, FALLBACK_ROW_GROUPS));
-            let _e47 = atomicMax((&fallback_count.groups_y), (((g_1 + FALLBACK_ROW_GROUPS) - 1u) / FALLBACK_ROW_GROUPS));
-            return;
-        } else {
-            return;
+    textureStore(output, q, _e11);
+    return select(0u, (1u << i_2), (_e11.w == 0f));
+}
+
+fn fallback_list_block(q0_: vec2<u32>, side: u32, listed_1: u32) {
+    var bits: u32;
+    var j_1: u32 = 0u;
+
+    if (listed_1 != 0u) {
+        let n_2 = countOneBits(listed_1);
+        let _e7 = atomicAdd((&fallback_count.listed), n_2);
+        bits = listed_1;
+        loop {
+            let _e10 = j_1;
+            if (_e10 < n_2) {
+            } else {
+                break;
+            }
+            {
+                let _e12 = bits;
+                let i_3 = firstTrailingBit(_e12);
+                let _e14 = bits;
+                let _e15 = bits;
+                bits = (_e14 & (_e15 - 1u));
+                let q_2 = (q0_ + vec2<u32>((i_3 % side), (i_3 / side)));
+                let _e26 = j_1;
+                fallback_pixels[(_e7 + _e26)] = (q_2.x | (q_2.y << 16u));
+            }
+            continuing {
+                let _e35 = j_1;
+                j_1 = (_e35 + 1u);
+            }
         }
+        let g_1 = ((((_e7 + n_2) - 1u) / 64u) + 1u);
+        let _e48 = atomicMax((&fallback_count.groups_x), min(g_1, FALLBACK_ROW_GROUPS));
+        let _e57 = atomicMax((&fallback_count.groups_y), (((g_1 + FALLBACK_ROW_GROUPS) - 1u) / FALLBACK_ROW_GROUPS));
+        return;
     } else {
-        textureStore(output, q, _e11);
         return;
     }
 }
 
 fn raymarch_pixel(x_3: u32, y_2: u32) -> vec3<f32> {
     var sum_1: f32 = 0f;
-    var j_1: u32;
+    var j_2: u32;
     var t_2: f32;
     var w_2: f32;
     var l: f32;
@@ -360,8 +385,8 @@ fn raymarch_pixel(x_3: u32, y_2: u32) -> vec3<f32> {
     let _e7 = raymarch_pixel_dirX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m_2, x_3, y_2);
     let _e11 = textureLoad(depth, vec2<u32>(x_3, y_2), 0i);
     let s = (min(max(_e11.x, 0f), m_2.eye.w) / max(dot(_e7, m_2.cam_forward.xyz), 0.000001f));
-    let n_2 = m_2.sizes.w;
-    let h_2 = (s / f32(n_2));
+    let n_3 = m_2.sizes.w;
+    let h_2 = (s / f32(n_3));
     let mx = m_2.interleave.x;
     let my = m_2.interleave.y;
     let stride = (mx * my);
@@ -369,20 +394,20 @@ fn raymarch_pixel(x_3: u32, y_2: u32) -> vec3<f32> {
     let _e37 = pixel_jitterX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(x_3, y_2);
     let u = select(0.5f, _e37, (m_2.interleave.z != 0u));
     let _e44 = raymarch_shadow_viewX_naga_oil_mod_XONRWC5DUMVZDUOTSMF4W2YLSMNUAX(m_2);
-    let _e48 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2, _e7, m_2.light_pos.xyz, 0f, s, n_2);
-    j_1 = pixel_class;
+    let _e48 = equiangularX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(eye_2, _e7, m_2.light_pos.xyz, 0f, s, n_3);
+    j_2 = pixel_class;
     loop {
-        let _e50 = j_1;
-        if (_e50 < n_2) {
+        let _e50 = j_2;
+        if (_e50 < n_3) {
         } else {
             break;
         }
         {
-            let _e52 = j_1;
+            let _e52 = j_2;
             t_2 = ((f32(_e52) + u) * h_2);
             w_2 = h_2;
             if false {
-                let _e59 = j_1;
+                let _e59 = j_2;
                 let _e62 = equiangular_sampleX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(_e48, (f32(_e59) + u));
                 t_2 = _e62.x;
                 w_2 = _e62.y;
@@ -397,15 +422,15 @@ fn raymarch_pixel(x_3: u32, y_2: u32) -> vec3<f32> {
                 sum_1 = (_e71 + ((_e69 * _e72) * _e84));
             } else {
                 let _e87 = sum_1;
-                let _e90 = j_1;
-                let _e93 = j_1;
+                let _e90 = j_2;
+                let _e93 = j_2;
                 let _e98 = transmittance_betweenX_naga_oil_mod_XONRWC5DUMVZDUOTNN5SGK3AX(m_2.medium.x, (f32(_e90) * h_2), (f32((_e93 + 1u)) * h_2));
                 sum_1 = (_e87 + (_e69 * _e98));
             }
         }
         continuing {
-            let _e101 = j_1;
-            j_1 = (_e101 + stride);
+            let _e101 = j_2;
+            j_2 = (_e101 + stride);
         }
     }
     let _e103 = sum_1;
@@ -426,15 +451,16 @@ fn raymarch_unwarp(@builtin(global_invocation_id) id: vec3<u32>) {
     var depths: vec4<f32> = vec4<f32>(0f, 0f, 0f, 0f);
     var light: array<vec3<f32>, 4>;
     var j: u32 = 0u;
+    var listed: u32 = 0u;
     var i: u32 = 0u;
     var local_1: bool;
 
     let _e6 = frame.sizes.x;
     let _e10 = frame.sizes.y;
     let screen_3 = vec2<u32>(_e6, _e10);
-    let q0_ = (id.xy * SCALE);
-    if !((q0_.x >= screen_3.x)) {
-        local = (q0_.y >= screen_3.y);
+    let q0_1 = (id.xy * SCALE);
+    if !((q0_1.x >= screen_3.x)) {
+        local = (q0_1.y >= screen_3.y);
     } else {
         local = true;
     }
@@ -442,7 +468,7 @@ fn raymarch_unwarp(@builtin(global_invocation_id) id: vec3<u32>) {
     if _e26 {
         return;
     }
-    let _e28 = lowres_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(q0_, screen_3, SCALE);
+    let _e28 = lowres_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(q0_1, screen_3, SCALE);
     loop {
         let _e30 = j;
         if (_e30 < 4u) {
@@ -472,25 +498,30 @@ fn raymarch_unwarp(@builtin(global_invocation_id) id: vec3<u32>) {
         {
             let _e62 = i;
             let _e65 = i;
-            let q_2 = (q0_ + vec2<u32>((_e62 % SCALE), (_e65 / SCALE)));
-            if (q_2.x < screen_3.x) {
-                local_1 = (q_2.y < screen_3.y);
+            let q_3 = (q0_1 + vec2<u32>((_e62 % SCALE), (_e65 / SCALE)));
+            if (q_3.x < screen_3.x) {
+                local_1 = (q_3.y < screen_3.y);
             } else {
                 local_1 = false;
             }
             let _e79 = local_1;
             if _e79 {
-                let _e81 = lowres_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(q_2, screen_3, SCALE);
+                let _e81 = lowres_tapsX_naga_oil_mod_XONRWC5DUMVZDUOTTMFWXA3DJNZTQX(q_3, screen_3, SCALE);
                 let w_3 = _e81.w;
-                let _e83 = depths;
-                let _e84 = light;
-                unwarp_pixel(q_2, w_3, w_3, _e83, _e84);
+                let _e84 = listed;
+                let _e85 = i;
+                let _e86 = depths;
+                let _e87 = light;
+                let _e88 = unwarp_pixel(q_3, _e85, w_3, w_3, _e86, _e87);
+                listed = (_e84 | _e88);
             }
         }
         continuing {
-            let _e86 = i;
-            i = (_e86 + 1u);
+            let _e91 = i;
+            i = (_e91 + 1u);
         }
     }
+    let _e93 = listed;
+    fallback_list_block(q0_1, SCALE, _e93);
     return;
 }

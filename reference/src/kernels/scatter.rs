@@ -314,7 +314,20 @@ pub fn scatter_main(
             let range = inp.bounds.load(b1 as u32 * lookup / stride - 1, row, 0);
             moment_z(d, [range[0], range[1]])
         };
-        let (add0, add1) = if tinted {
+        let (add0, add1) = if tinted && variant.resume {
+            let range_of = |row: u32| {
+                let range = inp.bounds.load(b1 as u32 * lookup / stride - 1, row, 0);
+                [range[0], range[1]]
+            };
+            resume.tinted(
+                [from0, from1],
+                [(x00, x01, fx0, row0), (x10, x11, fx1, row1)],
+                [lohi0, lohi1],
+                d,
+                [range_of(row0), range_of(row1)],
+                &coeffs,
+            )
+        } else if tinted {
             tinted_region(
                 inp,
                 variant,
@@ -660,6 +673,191 @@ impl Resume<'_> {
             mix4(scale(sa0, k0), scale(sa, k1), fx),
             mix4(scale(sb0, k0), scale(sb, k1), fx),
         ]
+    }
+
+    /// `texel_cookie` of rectified texel `i` of `row` (the white cookie without one).
+    fn cookie_of(&self, i: u32, row: u32, e: Vec3) -> Vec3 {
+        let white = TexArray::white();
+        super::prefilter::texel_cookie(
+            self.inp.frame,
+            self.inp.cookie.unwrap_or(&white),
+            self.variant.regions,
+            self.variant.filtered_stride,
+            i,
+            &self.inp.slices[row as usize],
+            e,
+            self.region,
+            self.proj,
+        )
+    }
+
+    /// With a cookie (`resume_cookie`): `row`'s mean cookie and per channel either `a(d) .
+    /// F^c` (Fourier: `at_origin` at the stored column) or the means of `C^c` times the
+    /// moments in `range`'s coordinate (layers 0 and 1), blended between `x0` and `x1` by
+    /// `fx`; the series or moments only where `series`.
+    #[allow(clippy::too_many_arguments, reason = "mirrors the WGSL signature")]
+    fn cookie(
+        &self,
+        origin: [u32; 2],
+        (x0, x1, fx): (u32, u32, f32),
+        d: f32,
+        at_origin: Vec3,
+        range: [f32; 2],
+        series: bool,
+        row: u32,
+    ) -> (Vec3, Vec3, [[[f32; 4]; 3]; 2]) {
+        let layers = self.variant.layers();
+        let moments = self.variant.basis == Basis::Moments;
+        let six = self.variant.moments == 6;
+        let f = self.inp.frame;
+        let e = if self.variant.light == LightKind::Spot {
+            slice_e(f, row_phi(f, row))
+        } else {
+            Vec3::ZERO
+        };
+        let scale = |v: [f32; 4], k: f32| v.map(|c| c * k);
+        let add = |a: [f32; 4], b: [f32; 4]| [a[0] + b[0], a[1] + b[1], a[2] + b[2], a[3] + b[3]];
+        let mut w = self.stored_w(origin, row);
+        let cb = self.inp.filtered.load(origin[0], row, 3 * layers);
+        let mut cs = Vec3::new(cb[0], cb[1], cb[2]) * w;
+        let mut vs = at_origin * w;
+        let mut sm = [[[0.0f32; 4]; 3]; 2];
+        if moments {
+            for c in 0..3u32 {
+                sm[0][c as usize] = scale(self.inp.filtered.load(origin[0], row, c * layers), w);
+                if six {
+                    sm[1][c as usize] =
+                        scale(self.inp.filtered.load(origin[0], row, c * layers + 1), w);
+                }
+            }
+        }
+        let (mut w0, mut cs0, mut vs0, mut sm0) = (w, cs, vs, sm);
+        for i in origin[1]..=x1 {
+            let wi = self.weight(i, row);
+            let ci = self.cookie_of(i, row, e) * wi;
+            w += wi;
+            cs += ci;
+            if series {
+                if moments {
+                    let z = moment_z(self.depth(i, row), range);
+                    let (m0, m1) = (moment_layer(z, 0), moment_layer(z, 1));
+                    for c in 0..3 {
+                        sm[0][c] = add(sm[0][c], scale(m0, ci[c]));
+                        if six {
+                            sm[1][c] = add(sm[1][c], scale(m1, ci[c]));
+                        }
+                    }
+                } else {
+                    vs += ci * step_series(self.depth(i, row) - d, 2 * layers);
+                }
+            }
+            if i == x0 {
+                (w0, cs0, vs0, sm0) = (w, cs, vs, sm);
+            }
+        }
+        let k0 = if w0 > 0.0 { 1.0 / w0 } else { 0.0 };
+        let k1 = if w > 0.0 { 1.0 / w } else { 0.0 };
+        let mixv = |a: Vec3, b: Vec3| a * (1.0 - fx) + b * fx;
+        let mut out = [[[0.0f32; 4]; 3]; 2];
+        for l in 0..2 {
+            for c in 0..3 {
+                out[l][c] = mix4(scale(sm0[l][c], k0), scale(sm[l][c], k1), fx);
+            }
+        }
+        (mixv(cs0 * k0, cs * k1), mixv(vs0 * k0, vs * k1), out)
+    }
+
+    /// `scatter`'s cookie branch with `resume`: both rows' cookie-weighted lit fractions
+    /// (`texels`: each row's two columns, the second's weight and the row; `lohi` their
+    /// bounds; `ranges` their regions' depth ranges for the moments).
+    fn tinted(
+        &self,
+        origins: [[u32; 2]; 2],
+        texels: [(u32, u32, f32, u32); 2],
+        lohi: [[f32; 4]; 2],
+        d: f32,
+        ranges: [[f32; 2]; 2],
+        coeffs: &[[f32; 4]],
+    ) -> (Vec3, Vec3) {
+        let layers = self.variant.layers();
+        let ambiguous = lohi.map(|l| d > l[0] && d <= l[1]);
+        let mut vis = [Vec3::ZERO; 2];
+        let mut cbar = [Vec3::ZERO; 2];
+        if self.variant.basis == Basis::Moments {
+            for row in 0..2 {
+                let (x0, x1, fx, r) = texels[row];
+                let (cb, _, m) = self.cookie(
+                    origins[row],
+                    (x0, x1, fx),
+                    d,
+                    Vec3::ZERO,
+                    ranges[row],
+                    ambiguous[row],
+                    r,
+                );
+                let zf = moment_z(d, ranges[row]);
+                cbar[row] = cb;
+                vis[row] = cb * 0.5;
+                for c in 0..3 {
+                    if ambiguous[row] && cb[c] > 0.0 {
+                        let m0 = m[0][c].map(|v| v / cb[c]);
+                        vis[row][c] = cb[c]
+                            * if self.variant.moments == 6 {
+                                let m1 = m[1][c].map(|v| v / cb[c]);
+                                lit_moments6(m0, [m1[0], m1[1]], zf)
+                            } else {
+                                lit_moments4(m0, zf)
+                            };
+                    }
+                }
+            }
+        } else {
+            let mut at = [Vec3::ZERO; 2];
+            if ambiguous[0] || ambiguous[1] {
+                for layer in 0..layers {
+                    let coeff = coeffs[layer as usize];
+                    for c in 0..3u32 {
+                        for row in 0..2 {
+                            let t = self.inp.filtered.load(
+                                origins[row][0],
+                                texels[row].3,
+                                c * layers + layer,
+                            );
+                            for k in 0..4 {
+                                at[row][c as usize] += coeff[k] * (t[k] * 2.0 - 1.0);
+                            }
+                        }
+                    }
+                }
+            }
+            for row in 0..2 {
+                let (x0, x1, fx, r) = texels[row];
+                let (cb, v, _) = self.cookie(
+                    origins[row],
+                    (x0, x1, fx),
+                    d,
+                    at[row],
+                    ranges[row],
+                    ambiguous[row],
+                    r,
+                );
+                cbar[row] = cb;
+                vis[row] = cb * 0.5 + v;
+            }
+        }
+        let fraction = |row: usize| {
+            let v = if d <= lohi[row][0] {
+                cbar[row]
+            } else if d > lohi[row][1] {
+                Vec3::ZERO
+            } else {
+                vis[row]
+            };
+            let c = cbar[row];
+            let f = |v: f32, c: f32| if c > 0.0 { clamp(v, 0.0, c) / c } else { 0.0 };
+            Vec3::new(f(v.x, c.x), f(v.y, c.y), f(v.z, c.z))
+        };
+        (fraction(0), fraction(1))
     }
 }
 

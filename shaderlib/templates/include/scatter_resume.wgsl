@@ -73,6 +73,24 @@ fn resume_w(origin: vec2<u32>, start: u32, row: u32) -> f32 {
     }
     return w;
 }
+{%- if cookie %}
+
+{% include "include/texel_cookie.wgsl" %}
+
+// With a cookie: a row's mean cookie and its per-channel parts, resumed and blended.
+struct ResumedCookie {
+    // The region's mean cookie Cbar up to the lookup.
+    cbar: vec3<f32>,
+{%- if moments %}
+    // Per channel c the means of C^c times the moments (layer 0 in `a`, 1 in `b`).
+    a: array<vec4<f32>, 3>,
+    b: array<vec4<f32>, 3>,
+{%- else %}
+    // Per channel c, a(d) . F^c (the means of C^c times the bases).
+    vis: vec3<f32>,
+{%- endif %}
+}
+{%- endif %}
 {%- if !moments %}
 
 // a(d) . B(di) for the ray's depth d and a texel's di: sum over the {{ bases / 2 }} frequencies c_k of
@@ -150,5 +168,98 @@ fn resume_moments(origin: vec2<u32>, start: u32, x0: u32, x1: u32, fx: f32, rang
     let k0 = select(0.0, 1.0 / w0, w0 > 0.0);
     let k1 = select(0.0, 1.0 / w, w > 0.0);
     return ResumedMoments(mix(sa0 * k0, sa * k1, fx), mix(sb0 * k0, sb * k1, fx));
+}
+{%- endif %}
+{%- if cookie && !moments %}
+
+// With a cookie, row `row`'s mean cookie and per channel a(d) . F^c, blended linearly between
+// rectified columns x0 and x1 (weight fx): `at_origin` holds a(d) . F^c at the stored column
+// `origin`; the channels' series only where `series` (the region is ambiguous for the row).
+fn resume_cookie(origin: vec2<u32>, start: u32, x0: u32, x1: u32, fx: f32, d: f32, at_origin: vec3<f32>, series: bool, row: u32, region: u32, proj: bool) -> ResumedCookie {
+    let sp = slice_params(slices[row]);
+    let e = resume_e(row);
+    var w = resume_w(origin, start, row);
+    var cs = w * filtered_load(origin.x, row, CBAR).xyz;
+    var vs = w * at_origin;
+    var w0 = w;
+    var cs0 = cs;
+    var vs0 = vs;
+    for (var i = origin.y; i <= x1; i++) {
+        let wi = resume_weight(sp, e, i, region, proj);
+        let ci = wi * texel_cookie(i, sp, e, region, proj);
+        w += wi;
+        cs += ci;
+        if series {
+            vs += ci * step_series(resume_depth(i, row, proj) - d);
+        }
+        if i == x0 {
+            w0 = w;
+            cs0 = cs;
+            vs0 = vs;
+        }
+    }
+    let k0 = select(0.0, 1.0 / w0, w0 > 0.0);
+    let k1 = select(0.0, 1.0 / w, w > 0.0);
+    return ResumedCookie(mix(cs0 * k0, cs * k1, fx), mix(vs0 * k0, vs * k1, fx));
+}
+{%- endif %}
+{%- if cookie && moments %}
+
+// With a cookie, row `row`'s mean cookie and per channel the means of C^c times the moments
+// (depth range `range`: `moment_z`), blended linearly between rectified columns x0 and x1
+// (weight fx), resumed from the stored column `origin`; the moments only where `series`.
+fn resume_cookie(origin: vec2<u32>, start: u32, x0: u32, x1: u32, fx: f32, range: vec2<f32>, series: bool, row: u32, region: u32, proj: bool) -> ResumedCookie {
+    let sp = slice_params(slices[row]);
+    let e = resume_e(row);
+    var w = resume_w(origin, start, row);
+    var cs = w * filtered_load(origin.x, row, CBAR).xyz;
+    var sa: array<vec4<f32>, 3>;
+    var sb: array<vec4<f32>, 3>;
+    for (var c = 0u; c < 3u; c++) {
+        sa[c] = w * filtered_load(origin.x, row, c * LAYERS);
+{%- if moment_count == 6 %}
+        sb[c] = w * filtered_load(origin.x, row, c * LAYERS + 1u);
+{%- else %}
+        sb[c] = vec4<f32>(0.0);
+{%- endif %}
+    }
+    var w0 = w;
+    var cs0 = cs;
+    var sa0 = sa;
+    var sb0 = sb;
+    for (var i = origin.y; i <= x1; i++) {
+        let wi = resume_weight(sp, e, i, region, proj);
+        let ci = wi * texel_cookie(i, sp, e, region, proj);
+        w += wi;
+        cs += ci;
+        if series {
+            let z = moment_z(resume_depth(i, row, proj), range);
+            let m0 = moment_layer(z, 0u);
+{%- if moment_count == 6 %}
+            let m1 = moment_layer(z, 1u);
+{%- endif %}
+            for (var c = 0u; c < 3u; c++) {
+                sa[c] += ci[c] * m0;
+{%- if moment_count == 6 %}
+                sb[c] += ci[c] * m1;
+{%- endif %}
+            }
+        }
+        if i == x0 {
+            w0 = w;
+            cs0 = cs;
+            sa0 = sa;
+            sb0 = sb;
+        }
+    }
+    let k0 = select(0.0, 1.0 / w0, w0 > 0.0);
+    let k1 = select(0.0, 1.0 / w, w > 0.0);
+    var out: ResumedCookie;
+    out.cbar = mix(cs0 * k0, cs * k1, fx);
+    for (var c = 0u; c < 3u; c++) {
+        out.a[c] = mix(sa0[c] * k0, sa[c] * k1, fx);
+        out.b[c] = mix(sb0[c] * k0, sb[c] * k1, fx);
+    }
+    return out;
 }
 {%- endif %}
