@@ -395,4 +395,24 @@ mod tests {
         assert!(!r16.fits_rectified_width(128));
         assert!(Family::Minmax.default_variant().fits_rectified_width(1));
     }
+
+    #[test]
+    fn resume_needs_a_stride_and_names_itself() {
+        let v = PrefilteredVariant {
+            resume: true,
+            ..PrefilteredVariant::default()
+        };
+        let err = v.validate().expect_err("resume with filtered_stride = 1");
+        assert_eq!(err.knob, "resume");
+        assert!(err.to_string().contains("filtered_stride"), "{err}");
+        let ok = PrefilteredVariant {
+            filtered_stride: 8,
+            ..v
+        };
+        assert!(ok.validate().is_ok());
+        assert!(ok.id().ends_with("-stride8-resume"), "{}", ok.id());
+        // Sized for its stride like the coarse map: 8 x 4^2 columns.
+        assert!(FamilyVariant::from(ok).fits_rectified_width(128));
+        assert!(!FamilyVariant::from(ok).fits_rectified_width(64));
+    }
 }

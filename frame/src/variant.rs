@@ -428,8 +428,8 @@ impl PrefilteredVariant {
             return Err(VariantError {
                 knob: "resume",
                 value: "true".into(),
-                allowed: "true only with filtered_stride = 2, 4 or 8 (with 1 every column is \
-                          stored and there is nothing to resume)"
+                allowed: "false with filtered_stride = 1 (true needs filtered_stride = 2, 4 or 8: \
+                          with 1 every column is stored and there is nothing to resume)"
                     .into(),
             });
         }

@@ -101,6 +101,47 @@ fn manifest_sizes_coarse_filtered_columns() {
     }
 }
 
+/// `resume`: `bounds` holds a second plane (the weight sums) and `scatter` and its fallback
+/// (the passes that evaluate the integral) read the rectified map at binding 10, as the
+/// manifest says.
+#[test]
+fn manifest_resume_sizes_bounds_and_binds_the_rectified_map() {
+    for k in [2, 4, 8] {
+        let v = PrefilteredVariant {
+            filtered_stride: k,
+            resume: true,
+            sampling: scatter_shaderlib::sampling::Sampling::Epipolar,
+            ..PrefilteredVariant::default()
+        };
+        let m = manifest(v);
+        let variant = &get(&m, "variants")[0];
+        let bounds = get(resource(variant, "bounds"), "buffer");
+        assert_eq!(
+            str_of(bounds, "size_bytes"),
+            format!("8 * 2 * ceil(rectified.width / {k}) * rectified.height"),
+            "{}",
+            v.id()
+        );
+        let passes = get(variant, "passes")
+            .as_array()
+            .cloned()
+            .unwrap_or_default();
+        let reads_rectified = |kernel: &str| {
+            passes
+                .iter()
+                .filter(|p| str_of(p, "kernel") == kernel)
+                .flat_map(|p| get(p, "bindings").as_array().cloned().unwrap_or_default())
+                .any(|b| {
+                    get(&b, "binding").as_u64() == Some(10) && str_of(&b, "resource") == "rectified"
+                })
+        };
+        for kernel in ["scatter", "scatter_fallback"] {
+            assert!(reads_rectified(kernel), "{}: {kernel}", v.id());
+        }
+        assert!(!reads_rectified("prefilter"), "{}", v.id());
+    }
+}
+
 #[test]
 fn manifest_resources_match_the_runtime() {
     for (&storage, &rectification) in Storage::ALL.iter().zip(Rectification::ALL.iter().cycle()) {
