@@ -2172,7 +2172,8 @@ pub fn write_area_chart(
 /// raymarch N over {16, 32, 64, 128, 256, 512} plus interleaved (64, 4x4) and (256, 4x4),
 /// minmax with both maps; for an area light (a case runs only the methods of its light),
 /// `area_ivsv` with 16, 64 and 256 VPLs, two grid sizes, the interleaved gather, and 64
-/// VPLs at lowres 2 and epipolar. Run it
+/// VPLs at lowres 2 and epipolar; the sampled configurations of every family's default, and
+/// of the prefiltered default at `filtered_stride` 8 with `resume`. Run it
 /// with `BenchConfig::rectified` = 512x512.
 pub fn tune_candidates() -> Vec<Method> {
     let mut out = Vec::new();
@@ -2269,6 +2270,18 @@ pub fn tune_candidates() -> Vec<Method> {
         for knobs in sampled_configs() {
             out.push(Method::from(base.with_sampling(knobs)));
         }
+    }
+    // The prefiltered default storing every eighth column and resuming between them
+    // (`resume`: the default's answer from an eighth of `prefilter`'s stores, for frames that
+    // look the map up at few points; docs/roofline.md, "Stop 58").
+    let resume8: FamilyVariant = PrefilteredVariant {
+        filtered_stride: 8,
+        resume: true,
+        ..PrefilteredVariant::default()
+    }
+    .into();
+    for knobs in sampled_configs() {
+        out.push(Method::from(resume8.with_sampling(knobs)));
     }
     // Issue 15: partial-sum trees (epipolar samples only): the rank, and the layout.
     for rank in [2, 4, 8] {

@@ -345,9 +345,9 @@ mod tests {
             assert_eq!(family.default_variant().family(), family);
             assert!(family.default_variant().validate().is_ok());
         }
-        // 2016 Fourier variants, 64 of the moment basis, 12 with a cookie and 132 with coarse
-        // filtered columns.
-        assert_eq!(Family::Prefiltered.grid().len(), 2016 + 64 + 12 + 132);
+        // 2016 Fourier variants, 64 of the moment basis, 12 with a cookie, 132 with coarse
+        // filtered columns and 30 with `resume`.
+        assert_eq!(Family::Prefiltered.grid().len(), 2016 + 64 + 12 + 132 + 30);
     }
 
     #[test]
