@@ -533,6 +533,8 @@ fn valid_value(family: Family, name: &str, pick: usize) -> String {
         "jitter" => &["true", "false"],
         // `cookie = true` needs `light = "spot"`, which another knob picks.
         "cookie" => &["false"],
+        // `resume = true` needs `filtered_stride` above 1, which another knob picks.
+        "resume" => &["false"],
         _ => &["1"],
     };
     options[pick % options.len()].to_owned()
@@ -572,6 +574,7 @@ fn bad_value(family: Family, name: &str, pick: usize) -> String {
         "interleave" => &["0", "9", "\"two\""],
         "jitter" => &["\"maybe\"", "2", "\"yes\""],
         "cookie" => &["\"maybe\"", "2", "\"yes\""],
+        "resume" => &["\"maybe\"", "2", "\"yes\""],
         "sampling" => &["\"epipole\"", "\"lowres2\"", "2"],
         "scale" => &["3", "0", "8", "\"two\""],
         "depth_break" => &["0", "51", "\"x\""],
