@@ -19,7 +19,8 @@ use scatter_shaderlib::{BuiltKernel, Kernel, KernelParams, ShaderError, build, r
 /// visibility x light x storage x rectification, the moment basis (4 or 6 moments) x
 /// regions x visibility x light x rectification, the spot's cookie (3 bases x visibility
 /// x rectification), and the coarse filtered columns (`filtered_stride` 2, 4, 8 x light x
-/// rectification x visibility x 5 bases, and 4 cookie variants each).
+/// rectification x visibility x 5 bases, and 4 cookie variants each), and `resume` (each
+/// stride x light x rectification x visibility, the bases cycling, and 2 cookie variants).
 fn cross_product() -> Vec<PrefilteredVariant> {
     PrefilteredVariant::grid(PrefilteredVariant::REGIONS)
 }
@@ -35,9 +36,10 @@ fn full_cross_product_validates() {
         21 * (8 * 2 + 8) * 2 * 3 * 2
             + 2 * (8 * 2 + 8) * 2 * 2
             + 3 * 2 * 2
-            + 3 * (2 * 2 * 2 * 5 + 4),
+            + 3 * (2 * 2 * 2 * 5 + 4)
+            + 3 * (2 * 2 * 2 + 2),
         "21 (bases, bases_per_thread) pairs x regions (1..=8 with both rectifications, 9..=16 \
-         epipolar only); 2 moment counts (rgba32float only); cookies; filtered strides"
+         epipolar only); 2 moment counts (rgba32float only); cookies; filtered strides; resume"
     );
     let start = Instant::now();
     // (kernel, rendered source) -> first parameter set that produced it.
@@ -82,10 +84,14 @@ fn full_cross_product_validates() {
     // Scatter: the Fourier layer counts (6 bases values) x the 3 storage formats (the
     // `filtered` buffer's element) and the 2 moment counts (rgba32float only), each x
     // (regions x rectification: 8 x 2 + 8 epipolar) x visibility x light; the cookie's 3 bases x visibility x
-    // rectification; every coarse-column variant (its stride is in the source).
+    // rectification; every coarse-column variant (its stride is in the source), and every
+    // `resume` one.
     assert_eq!(
         per_kernel[&Kernel::Scatter],
-        (6 * 3 + 2) * (8 * 2 + 8) * 2 * 2 + 3 * 2 * 2 + 3 * (2 * 2 * 2 * 5 + 4)
+        (6 * 3 + 2) * (8 * 2 + 8) * 2 * 2
+            + 3 * 2 * 2
+            + 3 * (2 * 2 * 2 * 5 + 4)
+            + 3 * (2 * 2 * 2 + 2)
     );
     assert_eq!(per_kernel[&Kernel::Prefilter], variants.len());
     eprintln!(
