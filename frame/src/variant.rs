@@ -542,23 +542,7 @@ impl PrefilteredVariant {
     /// (Fourier and 4 moments) at each stride (30 variants: every knob value meets every
     /// stride).
     fn resume_grid(regions: std::ops::RangeInclusive<u32>) -> Vec<PrefilteredVariant> {
-        let bases = [
-            Self::default(),
-            Self {
-                bases: 16,
-                bases_per_thread: 8,
-                storage: Storage::Rgba16float,
-                ..Self::default()
-            },
-            Self {
-                bases: 8,
-                bases_per_thread: 4,
-                storage: Storage::Rgba32float,
-                ..Self::default()
-            },
-            Self::with_moments(4),
-            Self::with_moments(6),
-        ];
+        let bases = Self::stride_grid_bases();
         let mut out = Vec::new();
         let mut n = 0;
         for k in Self::FILTERED_STRIDES.into_iter().filter(|&k| k > 1) {
@@ -616,14 +600,10 @@ impl PrefilteredVariant {
     /// this.
     pub const STRIDE_GRID_WIDTH: u32 = 64;
 
-    /// The coarse-column variants of [`Self::grid`]: every `filtered_stride` above 1 with
-    /// every light, rectification and visibility, each with five bases (m32-t16
-    /// rgba8unorm, m16-t8 rgba16float, m8-t4 rgba32float, 4 and 6 moments), the regions
-    /// cycling through those of `regions` that fit [`Self::STRIDE_GRID_WIDTH`]; then the
-    /// spot with its cookie (Fourier and 4 moments, both rectifications). Every knob value
-    /// meets every stride.
-    fn stride_grid(regions: std::ops::RangeInclusive<u32>) -> Vec<PrefilteredVariant> {
-        let bases = [
+    /// The five bases the coarse-column and `resume` grids run: m32-t16 rgba8unorm, m16-t8
+    /// rgba16float, m8-t4 rgba32float, 4 and 6 moments.
+    fn stride_grid_bases() -> [PrefilteredVariant; 5] {
+        [
             Self::default(),
             Self {
                 bases: 16,
@@ -639,7 +619,17 @@ impl PrefilteredVariant {
             },
             Self::with_moments(4),
             Self::with_moments(6),
-        ];
+        ]
+    }
+
+    /// The coarse-column variants of [`Self::grid`]: every `filtered_stride` above 1 with
+    /// every light, rectification and visibility, each with five bases (m32-t16
+    /// rgba8unorm, m16-t8 rgba16float, m8-t4 rgba32float, 4 and 6 moments), the regions
+    /// cycling through those of `regions` that fit [`Self::STRIDE_GRID_WIDTH`]; then the
+    /// spot with its cookie (Fourier and 4 moments, both rectifications). Every knob value
+    /// meets every stride.
+    fn stride_grid(regions: std::ops::RangeInclusive<u32>) -> Vec<PrefilteredVariant> {
+        let bases = Self::stride_grid_bases();
         let mut out = Vec::new();
         for k in Self::FILTERED_STRIDES.into_iter().filter(|&k| k > 1) {
             let fits: Vec<u32> = regions
