@@ -500,7 +500,13 @@ fn tinted_region(
             }
         }
     }
-    // Outside the row's depth range the region is exactly lit (the mean cookie) or shadowed.
+    cookie_fractions(d, lohi, cbar, vis)
+}
+
+/// Both rows' cookie-weighted lit fractions from their lit shares `vis`, mean cookies `cbar`
+/// and depth bounds `lohi`: outside a row's depth range the region is exactly lit (the mean
+/// cookie) or shadowed; the share clamped to [0, Cbar] over Cbar, 0 where Cbar is.
+fn cookie_fractions(d: f32, lohi: [[f32; 4]; 2], cbar: [Vec3; 2], vis: [Vec3; 2]) -> (Vec3, Vec3) {
     let fraction = |row: usize| {
         let v = if d <= lohi[row][0] {
             cbar[row]
@@ -845,19 +851,7 @@ impl Resume<'_> {
                 vis[row] = cb * 0.5 + v;
             }
         }
-        let fraction = |row: usize| {
-            let v = if d <= lohi[row][0] {
-                cbar[row]
-            } else if d > lohi[row][1] {
-                Vec3::ZERO
-            } else {
-                vis[row]
-            };
-            let c = cbar[row];
-            let f = |v: f32, c: f32| if c > 0.0 { clamp(v, 0.0, c) / c } else { 0.0 };
-            Vec3::new(f(v.x, c.x), f(v.y, c.y), f(v.z, c.z))
-        };
-        (fraction(0), fraction(1))
+        cookie_fractions(d, lohi, cbar, vis)
     }
 }
 
